@@ -1,0 +1,4 @@
+// SPDX-License-Identifier: MIT
+#include <CppUTest/CommandLineTestRunner.h>
+
+int main(int argc, char** argv) { return CommandLineTestRunner::RunAllTests(argc, argv); }

@@ -1,0 +1,5 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+set -euo pipefail
+tools/ci/preset.sh host
+build/host/bin/hrg --help
