@@ -15,7 +15,8 @@ namespace hrg::hal {
 using sample_q31 = int32_t;
 
 inline constexpr std::size_t kAdcChannels = 2;  // 0: pickoff x (C), 1: pickoff y (D)
-inline constexpr std::size_t kDacChannels = 3;  // 0: pump (ring electrode), 1: forcer x, 2: forcer y
+inline constexpr std::size_t kDacChannels =
+    3;  // 0: pump (ring electrode), 1: forcer x, 2: forcer y
 
 struct ConverterInfo {
   uint32_t sample_rate_hz;  // samples per second per channel
