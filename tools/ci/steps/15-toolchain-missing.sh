@@ -15,7 +15,7 @@ check() {
       >"$log" 2>&1; then
     echo "toolchain $toolchain configured without its compiler" >&2; return 1
   fi
-  if ! grep -q "apt-get install $package" "$log"; then
+  if ! tr -s " \n" "  " <"$log" | grep -q "apt-get install $package"; then
     echo "toolchain $toolchain failed without naming '$package':" >&2; cat "$log" >&2; return 1
   fi
   echo "toolchain $toolchain: missing compiler reported, names $package"
