@@ -30,9 +30,7 @@ enum class Fault : uint16_t {
   external = 1u << 6,  // board fault input asserted
 };
 
-constexpr uint16_t fault_bit(Fault f) {
-  return static_cast<uint16_t>(f);
-}
+constexpr uint16_t fault_bit(Fault f) { return static_cast<uint16_t>(f); }
 
 // Default timing shared by the firmware and the simulated target.
 inline constexpr uint32_t kAdcRateHz = 100'000;                     // pickoff sampling
