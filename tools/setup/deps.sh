@@ -7,7 +7,7 @@
 set -euo pipefail
 
 host_pkgs=(g++ cmake ninja-build pkg-config ccache git libeigen3-dev cpputest libcpputest-dev
-  libtomlplusplus-dev libceres-dev python3 python3-numpy python3-scipy python3-matplotlib)
+  libtomlplusplus-dev libceres-dev zlib1g-dev python3 python3-numpy python3-scipy python3-matplotlib)
 test_pkgs=(clang clang-format libclang-rt-14-dev valgrind can-utils gpiod libgpiod-dev
   python3-can g++-aarch64-linux-gnu g++-arm-linux-gnueabihf libc6-dev-arm64-cross
   libc6-dev-armhf-cross qemu-user qemu-system-arm qemu-system-x86 gcc-arm-none-eabi
