@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: MIT
+#include "sim_target/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+namespace hrg::sim {
+
+namespace {
+
+void check_increasing(const std::vector<ProfilePoint>& points, const char* what) {
+  if (points.empty()) throw std::invalid_argument(std::string(what) + ": no points");
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    if (!(points[i].t_s > points[i - 1].t_s)) {
+      throw std::invalid_argument(std::string(what) + ": times must increase strictly (point " +
+                                  std::to_string(i) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+Profile Profile::constant(double value) {
+  Profile p;
+  p.offset_ = value;
+  return p;
+}
+
+Profile Profile::steps(std::vector<ProfilePoint> points) {
+  check_increasing(points, "steps profile");
+  Profile p;
+  p.kind_ = Kind::steps;
+  p.points_ = std::move(points);
+  return p;
+}
+
+Profile Profile::ramps(std::vector<ProfilePoint> points) {
+  check_increasing(points, "ramps profile");
+  Profile p;
+  p.kind_ = Kind::ramps;
+  p.points_ = std::move(points);
+  return p;
+}
+
+Profile Profile::sine(double amplitude, double freq_hz, double phase_rad) {
+  Profile p;
+  p.kind_ = Kind::sine;
+  p.amplitude_ = amplitude;
+  p.freq_hz_ = freq_hz;
+  p.phase_rad_ = phase_rad;
+  return p;
+}
+
+Profile Profile::table_file(const std::string& path, double scale) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open profile table");
+  std::vector<ProfilePoint> points;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream fields(line);
+    std::string a;
+    std::string b;
+    if (!(fields >> a)) continue;
+    char* end_a = nullptr;
+    const double t = std::strtod(a.c_str(), &end_a);
+    if (end_a == a.c_str() || *end_a != '\0') {
+      if (points.empty() && line_no == 1) continue;  // header line
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column 1 is not a number");
+    }
+    char* end_b = nullptr;
+    if (!(fields >> b)) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column 2 is missing");
+    }
+    const double v = std::strtod(b.c_str(), &end_b);
+    if (end_b == b.c_str() || *end_b != '\0' || !std::isfinite(v) || !std::isfinite(t)) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column 2 is not a number");
+    }
+    if (!points.empty() && !(t > points.back().t_s)) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": time does not increase");
+    }
+    points.push_back({t, v * scale});
+  }
+  if (points.empty()) throw std::runtime_error(path + ": profile table has no rows");
+  return ramps(std::move(points));
+}
+
+double Profile::value(double t_s) const {
+  switch (kind_) {
+    case Kind::constant: return offset_;
+    case Kind::sine:
+      return offset_ + amplitude_ * std::sin(2.0 * std::numbers::pi * freq_hz_ * t_s + phase_rad_);
+    case Kind::steps: {
+      auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
+                                 [](double t, const ProfilePoint& p) { return t < p.t_s; });
+      if (it == points_.begin()) return offset_ + points_.front().value;
+      return offset_ + std::prev(it)->value;
+    }
+    case Kind::ramps: {
+      if (t_s <= points_.front().t_s) return offset_ + points_.front().value;
+      if (t_s >= points_.back().t_s) return offset_ + points_.back().value;
+      auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
+                                 [](double t, const ProfilePoint& p) { return t < p.t_s; });
+      const ProfilePoint& b = *it;
+      const ProfilePoint& a = *std::prev(it);
+      const double u = (t_s - a.t_s) / (b.t_s - a.t_s);
+      return offset_ + a.value + u * (b.value - a.value);
+    }
+  }
+  return offset_;
+}
+
+}  // namespace hrg::sim
