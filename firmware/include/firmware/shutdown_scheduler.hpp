@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/mode.hpp"
+
+namespace hrg::fw {
+
+// Interval excitation shutdown (seed section 5): short free-decay windows feed
+// the identification; they should be spread evenly over the 4 theta_A circle,
+// since an uneven spread acts like extra weights in the least squares.
+struct WindowConfig {
+  uint32_t length_frames = 100;        // excitation off per window (base frames)
+  uint32_t period_frames = 500;        // minimum spacing between window starts
+  uint32_t max_wait_frames = 5000;     // open anyway after this long (a bin may never be reached)
+  uint32_t bins = 16;                  // 4 theta_A bins over the full circle (<= kMaxBins)
+  uint32_t windows_per_bin = 4;        // cap: the campaign ends when every bin holds this many
+  double condition_good = 1.0e4;       // estimator condition number that ends the campaign
+  double coverage_good = 0.9;          // estimator coverage (0..1) that ends the campaign
+  bool rotate_on_static_base = true;   // command the pattern angle to fill empty bins
+  double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
+  uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
+};
+
+// What the estimator reports about its own state.
+struct EstimatorHealth {
+  bool solved = false;     // a solution exists
+  double condition = 0.0;  // condition number of H^T H (max/min eigenvalue)
+  double coverage = 0.0;   // share of 4 theta bins with data, 0..1
+};
+
+struct WindowDecision {
+  bool open = false;              // start a free-decay window now
+  bool close = false;             // end the running window now
+  bool pattern_command = false;   // drive the pattern to pattern_target_rad
+  double pattern_target_rad = 0;  // theta_A target (physical angle)
+};
+
+class ShutdownScheduler {
+ public:
+  static constexpr uint32_t kMaxBins = 64;
+
+  explicit ShutdownScheduler(const WindowConfig& cfg = {});
+
+  // Once per base frame. `theta_rad`: theta_A (unwrapped or not);
+  // `theta_rate_rad_s`: its smoothed rate, used to tell a static base.
+  // Task context, no allocation.
+  WindowDecision step(Mode mode, double theta_rad, double theta_rate_rad_s,
+                      const EstimatorHealth& health);
+
+  // 4 theta bin index of a physical angle, 0..bins-1.
+  uint32_t bin_of(double theta_rad) const;
+  // theta_A nearest to `from_rad` whose 4 theta lies at the centre of `bin`.
+  double bin_centre_near(uint32_t bin, double from_rad) const;
+
+  uint32_t bin_count(uint32_t bin) const { return counts_[bin]; }
+  uint32_t windows() const { return windows_; }
+  bool campaign_done() const { return done_; }
+  bool in_window() const { return in_window_; }
+  // Share of base frames with excitation switched off by a window, 0..1.
+  double excitation_off_fraction() const;
+  uint64_t frames() const { return frames_; }
+  uint64_t off_frames() const { return off_frames_; }
+  const WindowConfig& config() const { return cfg_; }
+
+ private:
+  bool under_covered(uint32_t bin) const;
+  uint32_t least_covered_bin() const;
+
+  WindowConfig cfg_;
+  std::array<uint32_t, kMaxBins> counts_{};
+  uint64_t frames_ = 0;
+  uint64_t off_frames_ = 0;
+  uint32_t since_start_ = 0;
+  uint32_t in_window_frames_ = 0;
+  uint32_t since_done_ = 0;
+  uint32_t window_bin_ = 0;
+  uint32_t windows_ = 0;
+  bool in_window_ = false;
+  bool done_ = false;
+};
+
+}  // namespace hrg::fw

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/shutdown_scheduler.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace hrg::fw {
+
+namespace {
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+}  // namespace
+
+ShutdownScheduler::ShutdownScheduler(const WindowConfig& cfg) : cfg_(cfg) {
+  if (cfg_.bins == 0) cfg_.bins = 1;
+  if (cfg_.bins > kMaxBins) cfg_.bins = kMaxBins;
+  if (cfg_.length_frames == 0) cfg_.length_frames = 1;
+  // The first window may open as soon as the gyro operates.
+  since_start_ = cfg_.period_frames;
+}
+
+uint32_t ShutdownScheduler::bin_of(double theta_rad) const {
+  double phase = std::fmod(4.0 * theta_rad, kTwoPi);
+  if (phase < 0) phase += kTwoPi;
+  auto bin = static_cast<uint32_t>(phase / kTwoPi * cfg_.bins);
+  return bin >= cfg_.bins ? cfg_.bins - 1 : bin;
+}
+
+double ShutdownScheduler::bin_centre_near(uint32_t bin, double from_rad) const {
+  // 4 theta at the bin centre; theta repeats every pi/2.
+  const double centre = (static_cast<double>(bin) + 0.5) * kTwoPi / cfg_.bins / 4.0;
+  const double quarter = std::numbers::pi / 2.0;
+  const double k = std::round((from_rad - centre) / quarter);
+  return centre + k * quarter;
+}
+
+bool ShutdownScheduler::under_covered(uint32_t bin) const {
+  // Fill evenly: only bins at the current minimum count qualify.
+  return counts_[bin] <= counts_[least_covered_bin()];
+}
+
+uint32_t ShutdownScheduler::least_covered_bin() const {
+  uint32_t best = 0;
+  for (uint32_t b = 1; b < cfg_.bins; ++b) {
+    if (counts_[b] < counts_[best]) best = b;
+  }
+  return best;
+}
+
+double ShutdownScheduler::excitation_off_fraction() const {
+  return frames_ == 0 ? 0.0 : static_cast<double>(off_frames_) / static_cast<double>(frames_);
+}
+
+WindowDecision ShutdownScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
+                                       const EstimatorHealth& health) {
+  WindowDecision d;
+  ++frames_;
+  if (since_start_ < UINT32_MAX) ++since_start_;
+  if (in_window_) {
+    ++off_frames_;
+    if (mode != Mode::free_decay) {
+      // Aborted by a fault or a command: the window does not count.
+      in_window_ = false;
+      return d;
+    }
+    if (++in_window_frames_ >= cfg_.length_frames) {
+      in_window_ = false;
+      ++counts_[window_bin_];
+      ++windows_;
+      d.close = true;
+    }
+    return d;
+  }
+  const bool estimator_good = health.solved && health.condition > 0 &&
+                              health.condition <= cfg_.condition_good &&
+                              health.coverage >= cfg_.coverage_good;
+  // The per-bin cap bounds the excitation-off time when the estimator never
+  // gets there (e.g. a parameter it cannot see).
+  const bool cap_reached = counts_[least_covered_bin()] >= cfg_.windows_per_bin;
+  if (!done_ && (estimator_good || cap_reached)) {
+    done_ = true;
+    since_done_ = 0;
+  }
+  if (done_) {
+    if (cfg_.refresh_period_frames == 0 || ++since_done_ < cfg_.refresh_period_frames) return d;
+    counts_ = {};
+    done_ = false;
+  }
+  if (mode != Mode::operate || since_start_ < cfg_.period_frames) return d;
+  const uint32_t bin = bin_of(theta_rad);
+  const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
+  if (under_covered(bin) || (!is_static && since_start_ >= cfg_.max_wait_frames) ||
+      (is_static && !cfg_.rotate_on_static_base && since_start_ >= cfg_.max_wait_frames)) {
+    d.open = true;
+    in_window_ = true;
+    in_window_frames_ = 0;
+    window_bin_ = bin;
+    since_start_ = 0;
+    return d;
+  }
+  if (is_static && cfg_.rotate_on_static_base) {
+    d.pattern_command = true;
+    d.pattern_target_rad = bin_centre_near(least_covered_bin(), theta_rad);
+  }
+  return d;
+}
+
+}  // namespace hrg::fw

@@ -1,0 +1,166 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/shutdown_scheduler.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+#include "support/cpputest.hpp"
+
+using hrg::fw::EstimatorHealth;
+using hrg::fw::Mode;
+using hrg::fw::ShutdownScheduler;
+using hrg::fw::WindowConfig;
+using hrg::fw::WindowDecision;
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+
+WindowConfig small_config() {
+  WindowConfig c;
+  c.length_frames = 10;
+  c.period_frames = 50;
+  c.max_wait_frames = 400;
+  c.bins = 8;
+  c.windows_per_bin = 2;
+  return c;
+}
+
+// A minimal mode machine for the scheduler: operate <-> free_decay.
+struct Loop {
+  ShutdownScheduler s;
+  Mode mode = Mode::operate;
+  uint32_t opened = 0;
+  explicit Loop(const WindowConfig& c) : s(c) {}
+  WindowDecision frame(double theta, double rate, const EstimatorHealth& h = {}) {
+    const WindowDecision d = s.step(mode, theta, rate, h);
+    if (d.open) {
+      mode = Mode::free_decay;
+      ++opened;
+    }
+    if (d.close) mode = Mode::operate;
+    return d;
+  }
+};
+}  // namespace
+
+TEST_GROUP(ShutdownScheduler){};
+
+TEST(ShutdownScheduler, BinsFollowFourThetaAndRepeatEveryQuarterTurn) {
+  ShutdownScheduler s(small_config());  // 8 bins of 45 deg in 4 theta
+  LONGS_EQUAL(0, s.bin_of(0.0));
+  LONGS_EQUAL(1, s.bin_of(kPi / 16 + 1e-6));  // 4 theta just above 45 deg
+  LONGS_EQUAL(7, s.bin_of(-1e-6));            // just below 0 wraps to the last bin
+  LONGS_EQUAL(s.bin_of(0.3), s.bin_of(0.3 + kPi / 2));
+  DOUBLES_EQUAL(kPi / 32, s.bin_centre_near(0, 0.0), 1e-12);
+  DOUBLES_EQUAL(kPi / 32 + kPi / 2, s.bin_centre_near(0, kPi / 2), 1e-12);
+}
+
+TEST(ShutdownScheduler, WindowsHaveTheConfiguredLengthAndPeriod) {
+  Loop l(small_config());
+  // Turning base, theta sweeping fast: every bin is under-covered in turn.
+  uint32_t first_open = 0, second_open = 0, closes = 0, off = 0;
+  for (uint32_t f = 0; f < 200; ++f) {
+    const double theta = 0.005 * f;  // a 4 theta bin every 39 frames
+    const auto d = l.frame(theta, 2.0);
+    if (d.open && l.opened == 1) first_open = f;
+    if (d.open && l.opened == 2) second_open = f;
+    if (d.close) ++closes;
+    if (l.mode == Mode::free_decay) ++off;
+  }
+  LONGS_EQUAL(0, first_open);    // the first window opens at once
+  LONGS_EQUAL(50, second_open);  // then one per period
+  LONGS_EQUAL(4, closes);        // at 0, 50, 100, 150
+  LONGS_EQUAL(40, off);
+  DOUBLES_EQUAL(40.0 / 200.0, l.s.excitation_off_fraction(), 1e-12);
+}
+
+TEST(ShutdownScheduler, PrefersUnderCoveredBinsAndWaitsInACoveredOne) {
+  auto c = small_config();
+  c.max_wait_frames = 10'000;
+  Loop l(c);
+  // GIVEN one window already taken in bin 0
+  for (int f = 0; f < 11; ++f)
+    l.frame(0.01, 2.0);
+  LONGS_EQUAL(1, l.s.bin_count(0));
+  // WHEN theta stays in bin 0 on a moving base past the period
+  for (int f = 0; f < 300; ++f)
+    l.frame(0.01, 2.0);
+  // THEN no second window is taken there
+  LONGS_EQUAL(1, l.opened);
+  // AND as soon as theta enters bin 3 one opens
+  const auto d = l.frame(3.5 * kPi / 16, 2.0);
+  CHECK(d.open);
+}
+
+TEST(ShutdownScheduler, OpensAnywayAfterTheLongestWaitOnAMovingBase) {
+  Loop l(small_config());  // max wait 400
+  for (int f = 0; f < 11; ++f)
+    l.frame(0.01, 2.0);
+  uint32_t f = 11;
+  while (l.opened < 2 && f < 1000) {
+    l.frame(0.01, 2.0);
+    ++f;
+  }
+  LONGS_EQUAL(2, l.opened);
+  LONGS_EQUAL(400, f - 1);  // 400 frames after the first window opened at frame 0
+}
+
+TEST(ShutdownScheduler, OnAStaticBaseItCommandsThePatternToTheLeastCoveredBin) {
+  Loop l(small_config());
+  for (int f = 0; f < 11; ++f)
+    l.frame(0.01, 0.0);  // window in bin 0
+  WindowDecision d;
+  for (int f = 0; f < 60; ++f)
+    d = l.frame(0.01, 0.0);
+  CHECK(d.pattern_command);
+  // bin 1 is the first least-covered one: centre at 4 theta = 67.5 deg
+  DOUBLES_EQUAL(3.0 * kPi / 32, d.pattern_target_rad, 1e-12);
+  // WHEN the pattern gets there a window opens
+  d = l.frame(d.pattern_target_rad, 0.0);
+  CHECK(d.open);
+  LONGS_EQUAL(2, l.opened);
+}
+
+TEST(ShutdownScheduler, StopsWhenTheEstimatorReportsGoodConditionAndCoverage) {
+  Loop l(small_config());
+  EstimatorHealth good{true, 50.0, 1.0};
+  EstimatorHealth poor{true, 1e6, 1.0};
+  for (int f = 0; f < 100; ++f)
+    l.frame(0.05 * f, 2.0, poor);
+  const uint32_t before = l.opened;
+  CHECK(before >= 2);
+  CHECK_FALSE(l.s.campaign_done());
+  for (int f = 0; f < 1000; ++f)
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  LONGS_EQUAL(before, l.opened);  // a window running at the time may finish, none opens after
+}
+
+TEST(ShutdownScheduler, AWindowAbortedByAFaultDoesNotCount) {
+  ShutdownScheduler s(small_config());
+  auto d = s.step(Mode::operate, 0.01, 2.0, {});
+  CHECK(d.open);
+  s.step(Mode::free_decay, 0.01, 2.0, {});
+  s.step(Mode::fault, 0.01, 2.0, {});
+  CHECK_FALSE(s.in_window());
+  LONGS_EQUAL(0, s.bin_count(0));
+  LONGS_EQUAL(0, s.windows());
+}
+
+TEST(ShutdownScheduler, FillsAllBinsEvenlyOnASweep) {
+  auto c = small_config();
+  c.windows_per_bin = 3;
+  c.condition_good = 0;  // the estimator never says good: the cap ends the campaign
+  Loop l(c);
+  for (int f = 0; f < 40'000; ++f)
+    l.frame(1e-3 * f, 1.0);
+  CHECK(l.s.campaign_done());
+  uint32_t lo = 1000, hi = 0;
+  for (uint32_t b = 0; b < 8; ++b) {
+    lo = l.s.bin_count(b) < lo ? l.s.bin_count(b) : lo;
+    hi = l.s.bin_count(b) > hi ? l.s.bin_count(b) : hi;
+  }
+  LONGS_EQUAL(3, lo);
+  CHECK(hi - lo <= 1);
+}
