@@ -1,0 +1,195 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/can/messages.hpp"
+
+namespace hrg::fw::can {
+
+namespace {
+
+// Raw limits of common field widths, as physical values.
+constexpr double kS24 = 8388608.0;  // 2^23
+constexpr double kS16 = 32768.0;    // 2^15
+
+// clang-format off
+// name, start, len, signed, factor, offset, min, max, unit
+constexpr SignalDef kWaveX[] = {
+  {"cx_v", 0, 24, true, 1e-6, 0, -kS24 * 1e-6, (kS24 - 1) * 1e-6, "V"},
+  {"sx_v", 24, 24, true, 1e-6, 0, -kS24 * 1e-6, (kS24 - 1) * 1e-6, "V"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+  {"exc", 56, 1, false, 1, 0, 0, 1, ""},
+};
+constexpr SignalDef kWaveY[] = {
+  {"cy_v", 0, 24, true, 1e-6, 0, -kS24 * 1e-6, (kS24 - 1) * 1e-6, "V"},
+  {"sy_v", 24, 24, true, 1e-6, 0, -kS24 * 1e-6, (kS24 - 1) * 1e-6, "V"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kAngle[] = {
+  {"theta_a_rad", 0, 16, true, 1e-4, 0, -kS16 * 1e-4, (kS16 - 1) * 1e-4, "rad"},
+  {"output_angle_rad", 16, 32, true, 1e-7, 0, -2147483648.0 * 1e-7, 2147483647.0 * 1e-7, "rad"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kLoops[] = {
+  {"pll_freq_hz", 0, 32, false, 1e-5, 0, 0, 4294967295.0 * 1e-5, "Hz"},
+  {"quad_effort", 32, 16, true, 1e-4, 0, -1, 1, ""},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+  {"pll_locked", 56, 1, false, 1, 0, 0, 1, ""},
+};
+constexpr SignalDef kPump[] = {
+  {"pump_v", 0, 16, false, 1e-3, 0, 0, 65.535, "V"},
+  {"pump_phase_rad", 16, 16, true, 1e-4, 0, -3.1416, 3.1416, "rad"},
+  {"agc_setpoint_v", 32, 16, false, 1e-4, 0, 0, 6.5535, "V"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kStatus[] = {
+  {"mode", 0, 8, false, 1, 0, 0, 7, ""},
+  {"exc_on", 8, 1, false, 1, 0, 0, 1, ""},
+  {"exc_line", 9, 1, false, 1, 0, 0, 1, ""},
+  {"fault_input", 10, 1, false, 1, 0, 0, 1, ""},
+  {"ident_active", 11, 1, false, 1, 0, 0, 1, ""},
+  {"faults", 16, 16, false, 1, 0, 0, 65535, ""},
+  {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kEstDamping[] = {
+  {"nu_per_s", 0, 24, false, 1e-8, 0, 0, 16777215.0 * 1e-8, "1/s"},
+  {"dnu_c_per_s", 24, 16, true, 1e-7, 0, -kS16 * 1e-7, (kS16 - 1) * 1e-7, "1/s"},
+  {"dnu_s_per_s", 40, 16, true, 1e-7, 0, -kS16 * 1e-7, (kS16 - 1) * 1e-7, "1/s"},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kEstSplit[] = {
+  {"dw_c_rad_s", 0, 24, true, 1e-8, 0, -kS24 * 1e-8, (kS24 - 1) * 1e-8, "rad/s"},
+  {"dw_s_rad_s", 24, 24, true, 1e-8, 0, -kS24 * 1e-8, (kS24 - 1) * 1e-8, "rad/s"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kEstQuality[] = {
+  {"cond_log10", 0, 16, false, 1e-3, 0, 0, 65.535, ""},
+  {"coverage", 16, 16, false, 1e-4, 0, 0, 1, ""},
+  {"windows", 32, 16, false, 1, 0, 0, 65535, ""},
+  {"valid", 48, 1, false, 1, 0, 0, 1, ""},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kExec[] = {
+  {"overruns", 0, 16, false, 1, 0, 0, 65535, ""},
+  {"missed_ticks", 16, 16, false, 1, 0, 0, 65535, ""},
+  {"max_frame_us", 32, 16, false, 1, 0, 0, 65535, "us"},
+  {"cpu_load_pct", 48, 8, false, 0.5, 0, 0, 127.5, "%"},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kInfo[] = {
+  {"protocol_version", 0, 8, false, 1, 0, 0, 255, ""},
+  {"angular_gain", 8, 16, false, 1e-5, 0, 0, 0.65535, ""},
+  {"window_period_s", 24, 16, false, 0.1, 0, 0, 6553.5, "s"},
+  {"window_length_s", 40, 16, false, 1e-3, 0, 0, 65.535, "s"},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kCanStats[] = {
+  {"tx_queue_full", 0, 16, false, 1, 0, 0, 65535, ""},
+  {"error_frames", 16, 16, false, 1, 0, 0, 65535, ""},
+  {"bus_off_events", 32, 8, false, 1, 0, 0, 255, ""},
+  {"restarts", 40, 8, false, 1, 0, 0, 255, ""},
+  {"can_state", 48, 2, false, 1, 0, 0, 3, ""},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+};
+
+// Commands: [payload..., counter (4 bits) + 4 reserved zero bits, CRC-8].
+constexpr SignalDef kSetMode[] = {
+  {"mode", 0, 8, false, 1, 0, 0, 7, ""},
+  {"counter", 8, 4, false, 1, 0, 0, 15, ""},
+  {"crc", 16, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kIdent[] = {
+  {"action", 0, 8, false, 1, 0, 0, 1, ""},
+  {"counter", 8, 4, false, 1, 0, 0, 15, ""},
+  {"crc", 16, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kWindow[] = {
+  {"period_s", 0, 16, false, 0.1, 0, 1, 3600, "s"},
+  {"length_s", 16, 16, false, 1e-3, 0, 0.01, 5, "s"},
+  {"counter", 32, 4, false, 1, 0, 0, 15, ""},
+  {"crc", 40, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kAgc[] = {
+  {"setpoint_v", 0, 16, false, 1e-4, 0, 0.05, 2, "V"},
+  {"counter", 16, 4, false, 1, 0, 0, 15, ""},
+  {"crc", 24, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kStatusRequest[] = {
+  {"counter", 0, 4, false, 1, 0, 0, 15, ""},
+  {"crc", 8, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kReplySignals[] = {
+  {"command_id", 0, 8, false, 1, 0, 0, 255, ""},
+  {"counter", 8, 4, false, 1, 0, 0, 15, ""},
+  {"result", 12, 4, false, 1, 0, 0, 15, ""},
+  {"detail", 16, 8, false, 1, 0, 0, 255, ""},
+  {"seq", 24, 8, false, 1, 0, 0, 255, ""},
+};
+// clang-format on
+
+constexpr bool fits(std::span<const SignalDef> sigs, uint8_t dlc) {
+  for (const auto& s : sigs) {
+    if (s.length == 0 || s.length > 32 || s.start_bit + s.length > 8u * dlc) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// clang-format off
+const std::array<MessageDef, kTelemetryCount> kTelemetry = {{
+  {"HRG_WAVE_X",      0x100, 8, 500, "HRG", kWaveX},
+  {"HRG_WAVE_Y",      0x101, 8, 500, "HRG", kWaveY},
+  {"HRG_ANGLE",       0x102, 7, 500, "HRG", kAngle},
+  {"HRG_LOOPS",       0x103, 8, 100, "HRG", kLoops},
+  {"HRG_PUMP",        0x104, 7, 100, "HRG", kPump},
+  {"HRG_STATUS",      0x105, 7,  10, "HRG", kStatus},
+  {"HRG_EST_DAMPING", 0x106, 8,   2, "HRG", kEstDamping},
+  {"HRG_EST_SPLIT",   0x107, 7,   2, "HRG", kEstSplit},
+  {"HRG_EST_QUALITY", 0x108, 8,   2, "HRG", kEstQuality},
+  {"HRG_EXEC",        0x109, 8,  10, "HRG", kExec},
+  {"HRG_INFO",        0x10A, 8,   1, "HRG", kInfo},
+  {"HRG_CAN_STATS",   0x10B, 8,   1, "HRG", kCanStats},
+}};
+
+const std::array<MessageDef, kCommandCount> kCommands = {{
+  {"HOST_SET_MODE",       0x080, 3, 0, "HOST", kSetMode},
+  {"HOST_IDENT",          0x081, 3, 0, "HOST", kIdent},
+  {"HOST_WINDOW",         0x082, 6, 0, "HOST", kWindow},
+  {"HOST_AGC",            0x083, 4, 0, "HOST", kAgc},
+  {"HOST_STATUS_REQUEST", 0x084, 2, 0, "HOST", kStatusRequest},
+}};
+
+const MessageDef kReply = {"HRG_CMD_REPLY", kReplyId, 4, 0, "HRG", kReplySignals};
+// clang-format on
+
+static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoops, 8) &&
+              fits(kPump, 7) && fits(kStatus, 7) && fits(kEstDamping, 8) && fits(kEstSplit, 7) &&
+              fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8));
+static_assert(fits(kSetMode, 3) && fits(kIdent, 3) && fits(kWindow, 6) && fits(kAgc, 4) &&
+              fits(kStatusRequest, 2) && fits(kReplySignals, 4));
+
+namespace {
+bool same(const char* a, const char* b) {
+  while (*a != '\0' && *a == *b) {
+    ++a;
+    ++b;
+  }
+  return *a == *b;
+}
+}  // namespace
+
+const MessageDef* find_message(uint32_t id) {
+  for (const auto& m : kTelemetry)
+    if (m.id == id) return &m;
+  for (const auto& m : kCommands)
+    if (m.id == id) return &m;
+  if (id == kReply.id) return &kReply;
+  return nullptr;
+}
+
+const SignalDef* find_signal(const MessageDef& m, const char* name) {
+  for (const auto& s : m.signals)
+    if (same(s.name, name)) return &s;
+  return nullptr;
+}
+
+}  // namespace hrg::fw::can

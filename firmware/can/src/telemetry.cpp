@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/can/telemetry.hpp"
+
+namespace hrg::fw::can {
+
+namespace {
+
+double b(bool v) { return v ? 1.0 : 0.0; }
+double sat_u(uint32_t v, uint32_t max) { return static_cast<double>(v > max ? max : v); }
+
+void put(const MessageDef& m, std::size_t index, double value, hal::CanFrame& f) {
+  encode_signal(m.signals[index], value, f);
+}
+
+}  // namespace
+
+TelemetryConfig TelemetryConfig::defaults() {
+  TelemetryConfig c;
+  for (std::size_t i = 0; i < kTelemetryCount; ++i)
+    c.rate_hz[i] = kTelemetry[i].default_rate_hz;
+  return c;
+}
+
+bool TelemetryConfig::valid(uint32_t base_rate_hz) const {
+  for (const auto r : rate_hz) {
+    if (r == 0) continue;
+    if (r > base_rate_hz || base_rate_hz % r != 0) return false;
+  }
+  return true;
+}
+
+double bus_load_fraction(const TelemetryConfig& config, uint32_t bitrate_bps) {
+  double bits_per_s = 0;
+  for (std::size_t i = 0; i < kTelemetryCount; ++i) {
+    bits_per_s += static_cast<double>(config.rate_hz[i]) *
+                  static_cast<double>(worst_case_frame_bits(kTelemetry[i].dlc));
+  }
+  return bits_per_s / static_cast<double>(bitrate_bps);
+}
+
+void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::CanFrame& f) {
+  const MessageDef& m = telemetry_def(message);
+  f = hal::CanFrame{};
+  f.id = m.id;
+  f.len = m.dlc;
+  switch (message) {
+    case Tm::wave_x:
+      put(m, sig::cx_v, s.cx_v, f);
+      put(m, sig::sx_v, s.sx_v, f);
+      put(m, sig::exc, b(s.exc_on), f);
+      break;
+    case Tm::wave_y:
+      put(m, sig::cy_v, s.cy_v, f);
+      put(m, sig::sy_v, s.sy_v, f);
+      break;
+    case Tm::angle:
+      put(m, sig::theta_a_rad, s.theta_a_rad, f);
+      put(m, sig::output_angle_rad, s.output_angle_rad, f);
+      break;
+    case Tm::loops:
+      put(m, sig::pll_freq_hz, s.pll_freq_hz, f);
+      put(m, sig::quad_effort, s.quad_effort, f);
+      put(m, sig::pll_locked, b(s.pll_locked), f);
+      break;
+    case Tm::pump:
+      put(m, sig::pump_v, s.pump_v, f);
+      put(m, sig::pump_phase_rad, s.pump_phase_rad, f);
+      put(m, sig::agc_setpoint_v, s.agc_setpoint_v, f);
+      break;
+    case Tm::status:
+      put(m, sig::mode, static_cast<double>(static_cast<uint8_t>(s.mode)), f);
+      put(m, sig::exc_on, b(s.exc_on), f);
+      put(m, sig::exc_line, b(s.exc_line), f);
+      put(m, sig::fault_input, b(s.fault_input), f);
+      put(m, sig::ident_active, b(s.ident_active), f);
+      put(m, sig::faults, s.faults, f);
+      put(m, sig::temp_c, s.temp_c, f);
+      break;
+    case Tm::est_damping:
+      put(m, sig::nu_per_s, s.nu_per_s, f);
+      put(m, sig::dnu_c_per_s, s.dnu_c_per_s, f);
+      put(m, sig::dnu_s_per_s, s.dnu_s_per_s, f);
+      break;
+    case Tm::est_split:
+      put(m, sig::dw_c_rad_s, s.dw_c_rad_s, f);
+      put(m, sig::dw_s_rad_s, s.dw_s_rad_s, f);
+      break;
+    case Tm::est_quality:
+      put(m, sig::cond_log10, s.cond_log10, f);
+      put(m, sig::coverage, s.coverage, f);
+      put(m, sig::windows, sat_u(s.windows, 65535), f);
+      put(m, sig::est_valid, b(s.est_valid), f);
+      break;
+    case Tm::exec:
+      put(m, sig::overruns, sat_u(s.overruns, 65535), f);
+      put(m, sig::missed_ticks, sat_u(s.missed_ticks, 65535), f);
+      put(m, sig::max_frame_us, sat_u(s.max_frame_us, 65535), f);
+      put(m, sig::cpu_load_pct, s.cpu_load_pct, f);
+      break;
+    case Tm::info:
+      put(m, sig::protocol_version, kProtocolVersion, f);
+      put(m, sig::angular_gain, s.angular_gain, f);
+      put(m, sig::window_period_s, s.window_period_s, f);
+      put(m, sig::window_length_s, s.window_length_s, f);
+      break;
+    case Tm::can_stats:
+      put(m, sig::tx_queue_full, sat_u(s.can.tx_queue_full, 65535), f);
+      put(m, sig::error_frames, sat_u(s.can.error_frames, 65535), f);
+      put(m, sig::bus_off_events, sat_u(s.can.bus_off_events, 255), f);
+      put(m, sig::restarts, sat_u(s.can.restarts, 255), f);
+      put(m, sig::can_state, static_cast<double>(static_cast<uint8_t>(s.can_state)), f);
+      break;
+  }
+  // Every telemetry message ends its table with `seq`.
+  const SignalDef* seq_sig = find_signal(m, "seq");
+  if (seq_sig != nullptr) put_bits(f, seq_sig->start_bit, seq_sig->length, seq);
+}
+
+TelemetryEncoder::TelemetryEncoder(const TelemetryConfig& config, uint32_t base_rate_hz)
+    : config_(config), base_rate_hz_(base_rate_hz), config_ok_(config.valid(base_rate_hz)) {
+  if (!config_ok_) config_ = TelemetryConfig::defaults();
+}
+
+std::size_t TelemetryEncoder::tick(const TelemetrySnapshot& s, std::span<hal::CanFrame> out) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < kTelemetryCount && n < out.size(); ++i) {
+    const uint16_t rate = config_.rate_hz[i];
+    if (rate == 0) continue;
+    // An invalid base rate leaves rates above it: send those every frame.
+    const uint64_t period = rate >= base_rate_hz_ ? 1 : base_rate_hz_ / rate;
+    if ((frame_ + i) % period != 0) continue;
+    encode_now(static_cast<Tm>(i), s, out[n++]);
+  }
+  ++frame_;
+  return n;
+}
+
+void TelemetryEncoder::encode_now(Tm message, const TelemetrySnapshot& s, hal::CanFrame& out) {
+  const auto i = static_cast<std::size_t>(message);
+  encode_telemetry(message, s, seq_[i], out);
+  seq_[i] = static_cast<uint8_t>(seq_[i] + 1u);
+}
+
+}  // namespace hrg::fw::can

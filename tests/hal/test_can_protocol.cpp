@@ -1,0 +1,276 @@
+// SPDX-License-Identifier: MIT
+// The CAN protocol in code: every telemetry signal round-trips at the edges of
+// its range, the encoder sends each message at its rate with a rolling
+// sequence counter, and the bus load of the default rates is below half the bus.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "firmware/can/messages.hpp"
+#include "firmware/can/telemetry.hpp"
+
+#include "support/cpputest.hpp"
+
+using namespace hrg::fw::can;
+using hrg::hal::CanFrame;
+
+namespace {
+
+// Edge values of a signal: the range ends, one LSB inside them, and zero when in range.
+int edge_values(const SignalDef& s, double* out) {
+  int n = 0;
+  out[n++] = s.min;
+  out[n++] = s.max;
+  out[n++] = s.min + s.factor;
+  out[n++] = s.max - s.factor;
+  if (s.min < 0 && s.max > 0) out[n++] = 0.0;
+  return n;
+}
+
+void check_all_edges(const MessageDef& m) {
+  for (std::size_t i = 0; i < m.signals.size(); ++i) {
+    const SignalDef& s = m.signals[i];
+    double edges[5];
+    const int n = edge_values(s, edges);
+    for (int e = 0; e < n; ++e) {
+      // Every other signal at its maximum: a layout overlap would corrupt it.
+      CanFrame f;
+      f.id = m.id;
+      f.len = m.dlc;
+      for (const auto& other : m.signals)
+        encode_signal(other, other.max, f);
+      encode_signal(s, edges[e], f);
+      DOUBLES_EQUAL(edges[e], decode_signal(s, f), 0.5 * s.factor + 1e-12 * std::fabs(edges[e]));
+      for (std::size_t j = 0; j < m.signals.size(); ++j) {
+        if (j == i) continue;
+        const SignalDef& o = m.signals[j];
+        DOUBLES_EQUAL(o.max, decode_signal(o, f), 0.5 * o.factor + 1e-12 * std::fabs(o.max));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TEST_GROUP(CanSignals){};
+
+TEST(CanSignals, EveryTelemetrySignalRoundTripsAtTheEdgesOfItsRange) {
+  for (const auto& m : kTelemetry)
+    check_all_edges(m);
+}
+
+TEST(CanSignals, EveryCommandAndReplySignalRoundTripsAtTheEdgesOfItsRange) {
+  for (const auto& m : kCommands)
+    check_all_edges(m);
+  check_all_edges(kReply);
+}
+
+TEST(CanSignals, ValuesBeyondTheRangeSaturateAndNanEncodesAsZero) {
+  const SignalDef& cx = telemetry_def(Tm::wave_x).signals[sig::cx_v];
+  CanFrame f;
+  encode_signal(cx, 100.0, f);
+  DOUBLES_EQUAL(cx.max, decode_signal(cx, f), 1e-12);
+  encode_signal(cx, -100.0, f);
+  DOUBLES_EQUAL(cx.min, decode_signal(cx, f), 1e-12);
+  encode_signal(cx, std::numeric_limits<double>::quiet_NaN(), f);
+  DOUBLES_EQUAL(0.0, decode_signal(cx, f), 0.0);
+  // quad_effort's range [-1, 1] is narrower than its 16-bit field.
+  const SignalDef& q = telemetry_def(Tm::loops).signals[sig::quad_effort];
+  encode_signal(q, 3.0, f);
+  DOUBLES_EQUAL(1.0, decode_signal(q, f), 1e-12);
+}
+
+TEST(CanSignals, SignedFieldsUseTwosComplementLittleEndian) {
+  // cx = -1 uV is raw -1: 24 bits all ones in bytes 0..2.
+  const SignalDef& cx = telemetry_def(Tm::wave_x).signals[sig::cx_v];
+  CanFrame f;
+  encode_signal(cx, -1e-6, f);
+  LONGS_EQUAL(0xFF, f.data[0]);
+  LONGS_EQUAL(0xFF, f.data[1]);
+  LONGS_EQUAL(0xFF, f.data[2]);
+  LONGS_EQUAL(0x00, f.data[3]);
+  // 0x123456 uV = 1.193046 V: least significant byte first.
+  encode_signal(cx, 1.193046, f);
+  LONGS_EQUAL(0x56, f.data[0]);
+  LONGS_EQUAL(0x34, f.data[1]);
+  LONGS_EQUAL(0x12, f.data[2]);
+}
+
+TEST_GROUP(Telemetry){};
+
+TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
+  // GIVEN a snapshot with a distinct in-range value in every field
+  TelemetrySnapshot s;
+  s.cx_v = 1.432790;
+  s.sx_v = -0.003621;
+  s.cy_v = 0.000607;
+  s.sy_v = -0.000013;
+  s.theta_a_rad = -0.7854;
+  s.output_angle_rad = 12.3456789;
+  s.pll_freq_hz = 4999.87310;
+  s.pll_locked = true;
+  s.quad_effort = -0.25;
+  s.pump_v = 9.519;
+  s.pump_phase_rad = 0.1234;
+  s.agc_setpoint_v = 1.5;
+  s.mode = hrg::fw::Mode::operate;
+  s.exc_on = true;
+  s.exc_line = true;
+  s.fault_input = false;
+  s.ident_active = true;
+  s.faults = static_cast<uint16_t>(hrg::fw::fault_bit(hrg::fw::Fault::adc_stuck) |
+                                   hrg::fw::fault_bit(hrg::fw::Fault::external));
+  s.temp_c = 32.26;
+  s.nu_per_s = 3.14159e-3;
+  s.dnu_c_per_s = 1.57e-4;
+  s.dnu_s_per_s = -2.3e-5;
+  s.dw_c_rad_s = 1.5708e-3;
+  s.dw_s_rad_s = -4.2e-4;
+  s.cond_log10 = 3.5;
+  s.coverage = 0.875;
+  s.windows = 42;
+  s.est_valid = true;
+  s.overruns = 70000;  // saturates at 65535
+  s.missed_ticks = 3;
+  s.max_frame_us = 612;
+  s.cpu_load_pct = 61.5;
+  s.angular_gain = 0.554;
+  s.window_period_s = 60.0;
+  s.window_length_s = 2.5;
+  s.can.tx_queue_full = 17;
+  s.can.error_frames = 5;
+  s.can.bus_off_events = 2;
+  s.can.restarts = 2;
+  s.can_state = hrg::hal::CanState::error_passive;
+  // WHEN each message is encoded, THEN its signals read back the fields
+  struct Expect {
+    Tm m;
+    const char* sig;
+    double value;
+  };
+  const Expect expect[] = {
+      {Tm::wave_x, "cx_v", 1.432790},
+      {Tm::wave_x, "sx_v", -0.003621},
+      {Tm::wave_x, "exc", 1},
+      {Tm::wave_y, "cy_v", 0.000607},
+      {Tm::wave_y, "sy_v", -0.000013},
+      {Tm::angle, "theta_a_rad", -0.7854},
+      {Tm::angle, "output_angle_rad", 12.3456789},
+      {Tm::loops, "pll_freq_hz", 4999.87310},
+      {Tm::loops, "pll_locked", 1},
+      {Tm::loops, "quad_effort", -0.25},
+      {Tm::pump, "pump_v", 9.519},
+      {Tm::pump, "pump_phase_rad", 0.1234},
+      {Tm::pump, "agc_setpoint_v", 1.5},
+      {Tm::status, "mode", 3},
+      {Tm::status, "exc_on", 1},
+      {Tm::status, "exc_line", 1},
+      {Tm::status, "fault_input", 0},
+      {Tm::status, "ident_active", 1},
+      {Tm::status, "faults", 8 + 64},
+      {Tm::status, "temp_c", 32.26},
+      {Tm::est_damping, "nu_per_s", 3.14159e-3},
+      {Tm::est_damping, "dnu_c_per_s", 1.57e-4},
+      {Tm::est_damping, "dnu_s_per_s", -2.3e-5},
+      {Tm::est_split, "dw_c_rad_s", 1.5708e-3},
+      {Tm::est_split, "dw_s_rad_s", -4.2e-4},
+      {Tm::est_quality, "cond_log10", 3.5},
+      {Tm::est_quality, "coverage", 0.875},
+      {Tm::est_quality, "windows", 42},
+      {Tm::est_quality, "valid", 1},
+      {Tm::exec, "overruns", 65535},
+      {Tm::exec, "missed_ticks", 3},
+      {Tm::exec, "max_frame_us", 612},
+      {Tm::exec, "cpu_load_pct", 61.5},
+      {Tm::info, "protocol_version", kProtocolVersion},
+      {Tm::info, "angular_gain", 0.554},
+      {Tm::info, "window_period_s", 60.0},
+      {Tm::info, "window_length_s", 2.5},
+      {Tm::can_stats, "tx_queue_full", 17},
+      {Tm::can_stats, "error_frames", 5},
+      {Tm::can_stats, "bus_off_events", 2},
+      {Tm::can_stats, "restarts", 2},
+      {Tm::can_stats, "can_state", 2},
+  };
+  for (const auto& e : expect) {
+    CanFrame f;
+    encode_telemetry(e.m, s, 200, f);
+    const MessageDef& m = telemetry_def(e.m);
+    LONGS_EQUAL(m.id, f.id);
+    LONGS_EQUAL(m.dlc, f.len);
+    const SignalDef* sd = find_signal(m, e.sig);
+    CHECK_TEXT(sd != nullptr, e.sig);
+    DOUBLES_EQUAL(e.value, decode_signal(*sd, f), 0.5 * sd->factor);
+    DOUBLES_EQUAL(200, decode_signal(*find_signal(m, "seq"), f), 0);
+  }
+}
+
+TEST(Telemetry, EachMessageIsSentAtItsRateWithARollingSequenceCounter) {
+  // GIVEN the default rates at the 1 kHz base frame
+  TelemetryEncoder enc(TelemetryConfig::defaults(), hrg::fw::kBaseRateHz);
+  CHECK(enc.config_ok());
+  TelemetrySnapshot s;
+  std::array<int, kTelemetryCount> count{};
+  std::array<int, kTelemetryCount> last_seq{};
+  last_seq.fill(-1);
+  std::array<CanFrame, kTelemetryCount> out;
+  // WHEN one second of base frames runs
+  for (uint32_t k = 0; k < hrg::fw::kBaseRateHz; ++k) {
+    const std::size_t n = enc.tick(s, out);
+    for (std::size_t j = 0; j < n; ++j) {
+      const MessageDef* m = find_message(out[j].id);
+      CHECK(m != nullptr);
+      const auto i = static_cast<std::size_t>(m - kTelemetry.data());
+      const int seq = static_cast<int>(decode_raw(*find_signal(*m, "seq"), out[j]));
+      // THEN each counter is the previous one plus one, modulo 256
+      if (last_seq[i] >= 0) LONGS_EQUAL((last_seq[i] + 1) % 256, seq);
+      last_seq[i] = seq;
+      ++count[i];
+    }
+  }
+  // THEN each message was sent rate_hz times: e.g. the wave 500 times, seq 499 % 256
+  for (std::size_t i = 0; i < kTelemetryCount; ++i) {
+    LONGS_EQUAL(kTelemetry[i].default_rate_hz, count[i]);
+    LONGS_EQUAL((kTelemetry[i].default_rate_hz - 1) % 256, last_seq[i]);
+  }
+}
+
+TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
+  TelemetryConfig c = TelemetryConfig::defaults();
+  c.rate_hz[static_cast<std::size_t>(Tm::wave_x)] = 1000;
+  c.rate_hz[static_cast<std::size_t>(Tm::angle)] = 0;  // off
+  TelemetryEncoder enc(c, 1000);
+  CHECK(enc.config_ok());
+  TelemetrySnapshot s;
+  std::array<CanFrame, kTelemetryCount> out;
+  int wave_x = 0;
+  int angle = 0;
+  for (int k = 0; k < 100; ++k) {
+    const std::size_t n = enc.tick(s, out);
+    for (std::size_t j = 0; j < n; ++j) {
+      wave_x += out[j].id == telemetry_def(Tm::wave_x).id ? 1 : 0;
+      angle += out[j].id == telemetry_def(Tm::angle).id ? 1 : 0;
+    }
+  }
+  LONGS_EQUAL(100, wave_x);
+  LONGS_EQUAL(0, angle);
+  c.rate_hz[static_cast<std::size_t>(Tm::status)] = 3;  // 1000 / 3 is not whole
+  CHECK_FALSE(c.valid(1000));
+  TelemetryEncoder bad(c, 1000);
+  CHECK_FALSE(bad.config_ok());
+  LONGS_EQUAL(10, bad.config().rate_hz[static_cast<std::size_t>(Tm::status)]);
+}
+
+TEST(Telemetry, DefaultBusLoadIsTheSumOfRateTimesWorstCaseFrameBits) {
+  // 8 data bytes: 47 + 64 + floor(97 / 4) = 135 bits; 7 bytes: 47 + 56 + 22 = 125 bits.
+  LONGS_EQUAL(135, worst_case_frame_bits(8));
+  LONGS_EQUAL(125, worst_case_frame_bits(7));
+  // wave x, y (8 B) and angle (7 B) at 500 Hz; loops (8 B) and pump (7 B) at 100 Hz;
+  // status (7 B) and exec (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info, can stats (8 B) at 1 Hz.
+  const double bits = 500.0 * (135 + 135 + 125) + 100.0 * (135 + 125) + 10.0 * (125 + 135) +
+                      2.0 * (135 + 125 + 135) + 1.0 * (135 + 135);
+  const double load = bus_load_fraction(TelemetryConfig::defaults(), kBitrateBps);
+  DOUBLES_EQUAL(bits / 1e6, load, 1e-12);
+  DOUBLES_EQUAL(0.22716, load, 1e-6);
+  CHECK(load < 0.5);
+}
