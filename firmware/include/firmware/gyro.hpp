@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/angle_output.hpp"
+#include "firmware/executive.hpp"
+#include "firmware/fault_monitor.hpp"
+#include "firmware/mode.hpp"
+#include "firmware/mode_machine.hpp"
+#include "firmware/ports.hpp"
+#include "firmware/shutdown_scheduler.hpp"
+#include "hal/board.hpp"
+
+namespace hrg::fw {
+
+struct GyroConfig {
+  double angular_gain = 0.554;       // K, from calibration (2 x Bryan factor)
+  double amplitude_set_v = 1.0;      // AGC set point for a_A at the pickoff
+  double amplitude_band = 0.05;      // |a_A - set| / set inside this counts as settled
+  double quadrature_band = 0.02;     // |a_B / a_A| inside this counts as settled
+  uint32_t self_test_frames = 20;    // power_up: clean frames before ring-up
+  uint32_t settle_frames = 200;      // lock: frames inside the bands before operate
+  uint32_t reacquire_frames = 10;    // recover: frames inside the bands before operate
+  uint32_t fault_hold_frames = 500;  // fault: clean frames before a retry
+  bool compensate_drift = true;      // add the identified drift to the output
+  bool identify = true;              // run the interval shutdown schedule
+  WindowConfig windows{};
+  MonitorConfig monitor{};
+};
+
+// Everything the firmware reports once per frame (telemetry, recordings).
+struct GyroStatus {
+  ChainOutputs chain{};
+  Mode mode = Mode::power_up;
+  uint16_t faults = 0;
+  bool excitation_on = false;  // drives permitted by the mode (exc column)
+  bool enable_line = false;
+  bool fault_input = false;
+  bool pattern_control = false;
+  double theta_unwrapped_rad = 0.0;
+  double out_angle_rad = 0.0;
+  double out_raw_angle_rad = 0.0;
+  double out_rate_rad_s = 0.0;
+  double drift_rad_s = 0.0;  // D used for the correction (Omega K units)
+  bool out_valid = false;
+  uint32_t adc_errors = 0;
+  uint32_t adc_missed_blocks = 0;
+  uint32_t dac_errors = 0;
+};
+
+// The firmware: wires the HAL board, the signal chain and the identifier to
+// the executive, the mode machine, the monitors, the interval shutdown
+// scheduler and the angle output. Everything is allocated at construction.
+class Gyro {
+ public:
+  static constexpr std::size_t kTaskCount = 6;
+
+  // `timer` measures task execution time (the board clock in real time, a
+  // host clock in lockstep).
+  Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier, hal::MonotonicClock& timer,
+       Pacing pacing, const GyroConfig& cfg);
+
+  // Runs one base frame (paced by the board's ADC block and clock).
+  void run_frame() { exec_.run_frame(*this); }
+
+  // Commands (CAN or host), applied at the next frame.
+  void command_pattern_angle(double theta_rad);
+  void release_pattern();
+  void command_safe() { mode_.handle(Event::command_safe); }
+  void command_restart() { mode_.handle(Event::command_restart); }
+  // Re-zeroes the output angle at the current pattern angle.
+  void zero_output() { output_.rereference(); }
+
+  const GyroStatus& status() const { return status_; }
+  const Executive<Gyro, kTaskCount>& executive() const { return exec_; }
+  const ModeMachine& mode_machine() const { return mode_; }
+  const ShutdownScheduler& scheduler() const { return scheduler_; }
+  const AngleOutput& output() const { return output_; }
+  const Identifier& identifier() const { return identifier_; }
+  const GyroConfig& config() const { return cfg_; }
+  // False when the board's converters do not match the firmware's block layout.
+  bool board_ok() const { return board_ok_; }
+
+  // Task bodies (rows of kTasks).
+  static void task_chain(Gyro& g);
+  static void task_supervise(Gyro& g);
+  static void task_identify(Gyro& g);
+  static void task_output(Gyro& g);
+  static void task_solve(Gyro& g);
+  static void task_telemetry(Gyro& g);
+
+ private:
+  void on_mode_change(Mode from, Mode to);
+  bool in_bands() const;
+  void step_mode_progress(const WindowDecision& d);
+
+  hal::Board& board_;
+  SignalChain& chain_;
+  Identifier& identifier_;
+  GyroConfig cfg_;
+  Executive<Gyro, kTaskCount> exec_;
+  ModeMachine mode_;
+  FaultMonitor monitor_;
+  ShutdownScheduler scheduler_;
+  AngleOutput output_;
+  GyroStatus status_{};
+  ChainCommands commands_{};
+  std::array<hal::sample_q31, kBlockFrames * hal::kAdcChannels> adc_{};
+  std::array<hal::sample_q31, kBlockFrames * hal::kDacChannels> dac_{};
+  uint64_t expected_block_ns_ = 0;
+  uint64_t block_ns_ = 0;
+  uint32_t adc_clipped_ = 0;
+  uint32_t progress_frames_ = 0;  // frames the current mode's exit condition has held
+  bool adc_stuck_ = false;
+  bool dac_error_ = false;
+  bool host_pattern_ = false;
+  double host_pattern_target_rad_ = 0.0;
+  bool enable_written_ = false;
+  bool board_ok_ = true;
+  Mode last_mode_ = Mode::power_up;
+};
+
+// The task table. The fast chain first (ADC -> demod -> PLL/AGC/quadrature ->
+// DAC): the DAC block written in this frame is output one block later, so
+// anything before it would add a frame of latency to the loops. Then decide
+// (supervise), then use the fresh sample (identify, output); the slow tasks last.
+inline constexpr std::array<Task<Gyro>, Gyro::kTaskCount> kGyroTasks{{
+    // name        function                 rate_hz      budget_ns
+    {"chain", &Gyro::task_chain, kBaseRateHz, 400'000},
+    {"supervise", &Gyro::task_supervise, kBaseRateHz, 40'000},
+    {"identify", &Gyro::task_identify, kBaseRateHz, 40'000},
+    {"output", &Gyro::task_output, kBaseRateHz, 20'000},
+    {"solve", &Gyro::task_solve, 10, 200'000},
+    {"telemetry", &Gyro::task_telemetry, 100, 100'000},
+}};
+static_assert(all_rates_divide(kGyroTasks, kBaseRateHz),
+              "every task rate must divide the base rate");
+static_assert(total_budget_ns(kGyroTasks) < 1'000'000'000ull / kBaseRateHz,
+              "the worst frame's budgets must fit in the base period");
+
+}  // namespace hrg::fw

@@ -1,0 +1,211 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/gyro.hpp"
+
+#include <cmath>
+
+namespace hrg::fw {
+
+Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
+           hal::MonotonicClock& timer, Pacing pacing, const GyroConfig& cfg)
+    : board_(board),
+      chain_(chain),
+      identifier_(identifier),
+      cfg_(cfg),
+      exec_(kGyroTasks, kBaseRateHz, board.clock, timer, pacing),
+      monitor_(cfg.monitor),
+      scheduler_(cfg.windows),
+      output_(cfg.angular_gain, 1.0 / kBaseRateHz) {
+  monitor_.set_amplitude_set_v(cfg_.amplitude_set_v);
+  const hal::ConverterInfo adc = board.adc.info();
+  const hal::ConverterInfo dac = board.dac.info();
+  // The buffers are sized at compile time; a board with another layout is
+  // refused (the firmware stays in power_up with drives off).
+  board_ok_ = adc.block_frames == kBlockFrames && dac.block_frames == kBlockFrames &&
+              adc.sample_rate_hz == kAdcRateHz;
+  block_ns_ = 1'000'000'000ull / kBaseRateHz;
+  (void)board_.excitation_enable.write(false);
+}
+
+void Gyro::command_pattern_angle(double theta_rad) {
+  host_pattern_ = true;
+  host_pattern_target_rad_ = theta_rad;
+}
+
+void Gyro::release_pattern() { host_pattern_ = false; }
+
+void Gyro::task_chain(Gyro& g) {
+  uint64_t t_first_ns = 0;
+  uint32_t clipped = 0;
+  const hal::Status st = g.board_.adc.read_block(g.adc_, t_first_ns, clipped);
+  if (st != hal::Status::ok) {
+    ++g.status_.adc_errors;
+    return;
+  }
+  if (g.expected_block_ns_ != 0 && t_first_ns > g.expected_block_ns_) {
+    g.status_.adc_missed_blocks +=
+        static_cast<uint32_t>((t_first_ns - g.expected_block_ns_ + g.block_ns_ / 2) / g.block_ns_);
+  }
+  g.expected_block_ns_ = t_first_ns + g.block_ns_;
+  g.adc_clipped_ = clipped;
+  g.adc_stuck_ = adc_block_stuck(g.adc_, hal::kAdcChannels);
+
+  const ModePolicy& p = g.mode_.permissions();
+  ChainCommands& c = g.commands_;
+  c.pump_on = p.pump && g.board_ok_;
+  c.forcers_on = p.forcers && g.board_ok_;
+  c.ring_up = g.mode_.mode() == Mode::ring_up;
+  c.amplitude_set_v = g.cfg_.amplitude_set_v;
+  g.chain_.process(g.adc_, g.dac_, c, g.status_.chain);
+  g.status_.chain.t_s = static_cast<double>(t_first_ns + g.block_ns_) * 1e-9;
+
+  // The mode gate, independent of what the chain computed: drives that the
+  // mode does not permit are written as zero.
+  for (std::size_t i = 0; i < kBlockFrames; ++i) {
+    if (!c.pump_on) g.dac_[i * hal::kDacChannels] = 0;
+    if (!c.forcers_on) {
+      g.dac_[i * hal::kDacChannels + 1] = 0;
+      g.dac_[i * hal::kDacChannels + 2] = 0;
+    }
+  }
+  const hal::Status dst = g.board_.dac.write_block(g.dac_);
+  if (dst != hal::Status::ok) ++g.status_.dac_errors;
+  g.dac_error_ = hal::is_fatal(dst);
+  g.status_.excitation_on = c.pump_on || c.forcers_on;
+  if (!c.pump_on) g.status_.chain.pump_v = 0.0;
+  if (g.enable_written_ != p.enable_line || g.exec_.tick() == 0) {
+    (void)g.board_.excitation_enable.write(p.enable_line && g.board_ok_);
+    g.enable_written_ = p.enable_line;
+  }
+  g.status_.enable_line = g.enable_written_ && g.board_ok_;
+}
+
+bool Gyro::in_bands() const {
+  const ChainOutputs& o = status_.chain;
+  if (!o.locked || cfg_.amplitude_set_v <= 0.0 || o.a_a_v <= 0.0) return false;
+  const double amp_err = std::fabs(o.a_a_v - cfg_.amplitude_set_v) / cfg_.amplitude_set_v;
+  return amp_err < cfg_.amplitude_band && std::fabs(o.a_b_v / o.a_a_v) < cfg_.quadrature_band;
+}
+
+void Gyro::step_mode_progress(const WindowDecision& d) {
+  const ChainOutputs& o = status_.chain;
+  switch (mode_.mode()) {
+    case Mode::power_up:
+      if (board_ok_ && ++progress_frames_ >= cfg_.self_test_frames) {
+        mode_.handle(Event::self_test_passed);
+      }
+      break;
+    case Mode::ring_up:
+      if (o.a_a_v >= (1.0 - cfg_.amplitude_band) * cfg_.amplitude_set_v) {
+        mode_.handle(Event::amplitude_reached);
+      }
+      break;
+    case Mode::lock:
+      progress_frames_ = in_bands() ? progress_frames_ + 1 : 0;
+      if (progress_frames_ >= cfg_.settle_frames) mode_.handle(Event::loops_settled);
+      break;
+    case Mode::operate:
+      if (d.open) mode_.handle(Event::window_open);
+      break;
+    case Mode::free_decay:
+      if (d.close) mode_.handle(Event::window_close);
+      break;
+    case Mode::recover:
+      progress_frames_ = in_bands() ? progress_frames_ + 1 : 0;
+      if (progress_frames_ >= cfg_.reacquire_frames) mode_.handle(Event::reacquired);
+      break;
+    case Mode::fault:
+      progress_frames_ = status_.faults == 0 ? progress_frames_ + 1 : 0;
+      if (progress_frames_ >= cfg_.fault_hold_frames) mode_.handle(Event::fault_cleared);
+      break;
+    case Mode::safe: break;
+  }
+}
+
+void Gyro::task_supervise(Gyro& g) {
+  bool fault_in = false;
+  (void)g.board_.fault_input.read(fault_in);
+  g.status_.fault_input = fault_in;
+  MonitorInputs in;
+  in.amplitude_v = g.status_.chain.a_a_v;
+  in.pll_locked = g.status_.chain.locked;
+  in.adc_clipped = g.adc_clipped_;
+  in.adc_samples = static_cast<uint32_t>(g.adc_.size());
+  in.adc_stuck = g.adc_stuck_;
+  in.recent_overruns = g.exec_.recent_overrun_frames();
+  in.external_fault = fault_in;
+  in.dac_error = g.dac_error_;
+  const uint16_t faults = g.monitor_.update(in, g.mode_.mode());
+  g.status_.faults = faults;
+  if (faults != 0 && g.mode_.mode() != Mode::fault && g.mode_.mode() != Mode::safe) {
+    g.mode_.handle(Event::fault_detected, faults);
+  }
+
+  // Window schedule; a host pattern command has priority over the scheduler's.
+  EstimatorHealth health = g.identifier_.health();
+  if (!g.cfg_.identify) health = {true, 1.0, 1.0};  // nothing to identify: never schedule
+  const WindowDecision d =
+      g.scheduler_.step(g.mode_.mode(), g.output_.theta_unwrapped_rad(),
+                        g.output_.rate_rad_s() * -g.cfg_.angular_gain / 2.0, health);
+  const bool operating = g.mode_.mode() == Mode::operate;
+  g.commands_.pattern_control = operating && (g.host_pattern_ || d.pattern_command);
+  g.commands_.pattern_target_rad =
+      g.host_pattern_ ? g.host_pattern_target_rad_ : d.pattern_target_rad;
+  g.status_.pattern_control = g.commands_.pattern_control;
+
+  if (faults == 0 || g.mode_.mode() == Mode::fault) g.step_mode_progress(d);
+  const Mode now = g.mode_.mode();
+  if (now != g.last_mode_) {
+    g.on_mode_change(g.last_mode_, now);
+    g.last_mode_ = now;
+  }
+  g.status_.mode = now;
+}
+
+void Gyro::on_mode_change(Mode from, Mode to) {
+  progress_frames_ = 0;
+  // The enable line follows the mode at once (the drives follow with the next block).
+  const bool enable = policy(to).enable_line && board_ok_;
+  (void)board_.excitation_enable.write(enable);
+  enable_written_ = enable;
+  if (to == Mode::free_decay) identifier_.begin_window(status_.chain.t_s);
+  if (from == Mode::free_decay) {
+    if (to == Mode::recover) {
+      identifier_.end_window();
+    } else {
+      identifier_.abort_window();
+    }
+  }
+}
+
+void Gyro::task_identify(Gyro& g) {
+  if (g.mode_.mode() == Mode::free_decay) g.identifier_.add_sample(g.status_.chain);
+}
+
+void Gyro::task_output(Gyro& g) {
+  const ChainOutputs& o = g.status_.chain;
+  const bool moving_on_purpose = g.status_.pattern_control;
+  if (moving_on_purpose) g.output_.rereference();
+  const double ratio = o.a_a_v > 0.0 ? o.a_b_v / o.a_a_v : 0.0;
+  const double drift =
+      g.cfg_.compensate_drift ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio) : 0.0;
+  const bool valid = g.mode_.permissions().output_valid && !moving_on_purpose;
+  g.output_.update(o.theta_a_rad, drift, valid);
+  GyroStatus& s = g.status_;
+  s.drift_rad_s = drift;
+  s.theta_unwrapped_rad = g.output_.theta_unwrapped_rad();
+  s.out_angle_rad = g.output_.angle_rad();
+  s.out_raw_angle_rad = g.output_.raw_angle_rad();
+  s.out_rate_rad_s = g.output_.rate_rad_s();
+  s.out_valid = g.output_.valid();
+}
+
+void Gyro::task_solve(Gyro& g) {
+  if (g.cfg_.identify) g.identifier_.solve();
+}
+
+void Gyro::task_telemetry(Gyro& g) {
+  // The CAN telemetry encoder is fed from status(); see firmware/can.
+  (void)g;
+}
+
+}  // namespace hrg::fw

@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+#include "firmware/ports.hpp"
+
+namespace hrg::fakes {
+
+// An envelope-level stand-in for the DSP chain and the resonator behind it:
+// a_A rises towards the set point at `ring_rate_v_per_block` while driven,
+// decays by `decay_per_block` (relative) while the drives are off; theta_A
+// turns at `theta_rate_rad_per_block` and moves towards a pattern target at
+// `pattern_rate_rad_per_block`. Back door: lock, amplitude and rates.
+// It writes a constant into every DAC word so the mode gate can be seen.
+class FakeChain final : public fw::SignalChain {
+ public:
+  void process(std::span<const hal::sample_q31>, std::span<hal::sample_q31> dac,
+               const fw::ChainCommands& cmd, fw::ChainOutputs& out) override {
+    ++calls_;
+    last_cmd_ = cmd;
+    for (auto& w : dac)
+      w = 1000;
+    const bool driven = cmd.pump_on || cmd.forcers_on;
+    if (driven) {
+      a_a_ += ring_rate_v_per_block;
+      if (a_a_ > cmd.amplitude_set_v) a_a_ = cmd.amplitude_set_v;
+    } else {
+      a_a_ *= 1.0 - decay_per_block;
+    }
+    theta_ += theta_rate_rad_per_block;
+    if (cmd.pattern_control) {
+      const double err = cmd.pattern_target_rad - theta_;
+      theta_ += std::fabs(err) < pattern_rate_rad_per_block
+                    ? err
+                    : std::copysign(pattern_rate_rad_per_block, err);
+    }
+    out.a_a_v = a_a_;
+    out.a_b_v = 0.0;
+    out.e_v2 = a_a_ * a_a_;
+    out.theta_a_rad = std::remainder(theta_, 1.5707963267948966);
+    out.locked = locked;
+    out.pump_v = cmd.pump_on ? 3.0 : 0.0;
+  }
+
+  double ring_rate_v_per_block = 0.01;
+  double decay_per_block = 1e-6;
+  double theta_rate_rad_per_block = 0.0;
+  double pattern_rate_rad_per_block = 1e-3;
+  bool locked = true;
+
+  void set_amplitude(double a) { a_a_ = a; }
+  double amplitude() const { return a_a_; }
+  double theta() const { return theta_; }
+  const fw::ChainCommands& last_commands() const { return last_cmd_; }
+  uint32_t calls() const { return calls_; }
+
+ private:
+  double a_a_ = 0.0;
+  double theta_ = 0.1;
+  fw::ChainCommands last_cmd_{};
+  uint32_t calls_ = 0;
+};
+
+// Records what the firmware asks of the identifier. Back door: health and drift.
+class FakeIdentifier final : public fw::Identifier {
+ public:
+  void begin_window(double t_s) override {
+    ++begun;
+    last_begin_s = t_s;
+    open = true;
+  }
+  void add_sample(const fw::ChainOutputs&) override { samples += open ? 1 : 0; }
+  void end_window() override {
+    ++ended;
+    open = false;
+  }
+  void abort_window() override {
+    ++aborted;
+    open = false;
+  }
+  void solve() override { ++solves; }
+  fw::EstimatorHealth health() const override { return health_; }
+  fw::Identification identification() const override { return {}; }
+  double drift_rad_s(double, double) const override { return drift; }
+
+  fw::EstimatorHealth health_{};
+  double drift = 0.0;
+  uint32_t begun = 0, ended = 0, aborted = 0, samples = 0, solves = 0;
+  double last_begin_s = 0.0;
+  bool open = false;
+};
+
+}  // namespace hrg::fakes

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+#include <array>
+#include <cstdint>
+
+#include "fakes/fake_board.hpp"
+#include "fakes/fake_chain.hpp"
+
+#include "support/cpputest.hpp"
+
+using hrg::hal::Status;
+
+TEST_GROUP(FakeBoard){};
+
+TEST(FakeBoard, EachAdcBlockMovesTheLockstepClockByOneBlock) {
+  hrg::fakes::FakeBoard b;
+  std::array<int32_t, 200> block{};
+  uint64_t t = 0;
+  uint32_t clipped = 9;
+  CHECK(Status::ok == b.adc.read_block(block, t, clipped));
+  LONGS_EQUAL(0, t);
+  LONGS_EQUAL(0, clipped);
+  LONGS_EQUAL(1'000'000, b.clock.now_ns());
+  b.adc.skip_blocks(2);
+  b.adc.read_block(block, t, clipped);
+  LONGS_EQUAL(3'000'000, t);
+  LONGS_EQUAL(4'000'000, b.clock.now_ns());
+}
+
+TEST(FakeBoard, AStuckAdcHoldsChannelY) {
+  hrg::fakes::FakeBoard b;
+  std::array<int32_t, 200> block{};
+  uint64_t t = 0;
+  uint32_t clipped = 0;
+  b.adc.set_stuck(true);
+  b.adc.read_block(block, t, clipped);
+  for (std::size_t i = 1; i < block.size(); i += 2)
+    LONGS_EQUAL(12345, block[i]);
+  CHECK(block[0] != block[2]);
+}
+
+TEST(FakeBoard, TheDacRemembersWhichChannelsWereDriven) {
+  hrg::fakes::FakeBoard b;
+  std::array<int32_t, 300> block{};
+  block[4] = 7;  // frame 1, forcer x
+  CHECK(Status::ok == b.dac.write_block(block));
+  CHECK_FALSE(b.dac.driving(0));
+  CHECK(b.dac.driving(1));
+  CHECK_FALSE(b.dac.driving(2));
+  b.dac.set_status(Status::io_error);
+  CHECK(Status::io_error == b.dac.write_block(block));
+}
+
+TEST_GROUP(FakeChain){};
+
+TEST(FakeChain, RingsUpToTheSetPointWhileDrivenAndDecaysWhenNot) {
+  hrg::fakes::FakeChain c;
+  std::array<int32_t, 200> adc{};
+  std::array<int32_t, 300> dac{};
+  hrg::fw::ChainCommands cmd;
+  cmd.pump_on = true;
+  cmd.amplitude_set_v = 0.5;
+  hrg::fw::ChainOutputs out;
+  for (int i = 0; i < 100; ++i)
+    c.process(adc, dac, cmd, out);
+  DOUBLES_EQUAL(0.5, out.a_a_v, 1e-12);
+  LONGS_EQUAL(1000, dac[5]);
+  cmd.pump_on = false;
+  c.decay_per_block = 0.5;
+  c.process(adc, dac, cmd, out);
+  DOUBLES_EQUAL(0.25, out.a_a_v, 1e-12);
+}
+
+TEST(FakeChain, MovesThePatternTowardsTheTarget) {
+  hrg::fakes::FakeChain c;
+  std::array<int32_t, 200> adc{};
+  std::array<int32_t, 300> dac{};
+  hrg::fw::ChainCommands cmd;
+  cmd.pattern_control = true;
+  cmd.pattern_target_rad = 0.2;
+  hrg::fw::ChainOutputs out;
+  for (int i = 0; i < 50; ++i)
+    c.process(adc, dac, cmd, out);
+  DOUBLES_EQUAL(0.15, c.theta(), 1e-12);  // from 0.1 at 1e-3 per block
+  for (int i = 0; i < 100; ++i)
+    c.process(adc, dac, cmd, out);
+  DOUBLES_EQUAL(0.2, c.theta(), 1e-12);
+}

@@ -1,0 +1,235 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/gyro.hpp"
+
+#include <cmath>
+#include <cstdint>
+
+#include "fakes/fake_board.hpp"
+#include "fakes/fake_chain.hpp"
+#include "fakes/fake_clock.hpp"
+
+#include "support/cpputest.hpp"
+
+using hrg::fw::Fault;
+using hrg::fw::fault_bit;
+using hrg::fw::Gyro;
+using hrg::fw::GyroConfig;
+using hrg::fw::Mode;
+using hrg::fw::Pacing;
+
+namespace {
+GyroConfig test_config() {
+  GyroConfig c;
+  c.angular_gain = 0.5;
+  c.amplitude_set_v = 1.0;
+  c.self_test_frames = 20;
+  c.settle_frames = 50;
+  c.reacquire_frames = 5;
+  c.fault_hold_frames = 100;
+  c.windows.length_frames = 100;
+  c.windows.period_frames = 400;
+  c.windows.bins = 8;
+  c.windows.windows_per_bin = 100;
+  c.windows.rotate_on_static_base = false;
+  c.windows.max_wait_frames = 400;
+  return c;
+}
+}  // namespace
+
+TEST_GROUP(Gyro) {
+  hrg::fakes::FakeBoard b;
+  hrg::fakes::FakeChain chain;
+  hrg::fakes::FakeIdentifier ident;
+  hrg::fakes::FakeClock timer;
+
+  void run(Gyro & g, int frames) {
+    for (int i = 0; i < frames; ++i)
+      g.run_frame();
+  }
+  // Runs until `mode` is reached; returns the frames it took (or -1).
+  int run_until(Gyro & g, Mode mode, int limit = 5000) {
+    for (int i = 1; i <= limit; ++i) {
+      g.run_frame();
+      if (g.status().mode == mode) return i;
+    }
+    return -1;
+  }
+};
+
+TEST(Gyro, PowersUpWithDrivesAndEnableOffThenRingsUpLocksAndOperates) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(g.board_ok());
+  g.run_frame();
+  CHECK(Mode::power_up == g.status().mode);
+  CHECK_FALSE(b.dac.driving(0));
+  CHECK_FALSE(b.dac.driving(1));
+  CHECK_FALSE(b.enable.level());
+  // 20 clean frames of self test (frame 1 counted above)
+  LONGS_EQUAL(19, run_until(g, Mode::ring_up));
+  // ring-up at 0.01 V per block to 0.95 V: 95 blocks, driven from the next frame
+  const int ring = run_until(g, Mode::lock);
+  CHECK(ring >= 94 && ring <= 96);
+  CHECK(b.enable.level());
+  // 50 frames inside the bands
+  LONGS_EQUAL(50, run_until(g, Mode::operate));
+  CHECK(b.dac.driving(0));
+  CHECK(b.dac.driving(1));
+  CHECK(g.status().out_valid);
+}
+
+TEST(Gyro, OpensFreeDecayWindowsWithDrivesOffAndFeedsTheIdentifier) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::operate) > 0);
+  CHECK(run_until(g, Mode::free_decay, 10) > 0);  // the first window opens at once
+  LONGS_EQUAL(1, ident.begun);
+  g.run_frame();
+  CHECK_FALSE(b.dac.driving(0));
+  CHECK_FALSE(b.dac.driving(1));
+  CHECK_FALSE(b.dac.driving(2));
+  CHECK(b.enable.level());  // the enable line stays up: drives are zero, not disconnected
+  CHECK(g.status().out_valid);
+  CHECK(run_until(g, Mode::recover, 200) > 0);
+  LONGS_EQUAL(1, ident.ended);
+  LONGS_EQUAL(100, ident.samples);
+  CHECK(run_until(g, Mode::operate, 50) > 0);
+  // Over 4000 frames of operation: a window of 100 every 400 frames
+  run(g, 4000);
+  CHECK(ident.begun >= 10 && ident.begun <= 11);
+  DOUBLES_EQUAL(0.25, g.scheduler().excitation_off_fraction(), 0.03);
+  CHECK(ident.solves >= 40);  // 10 Hz over more than 4 s
+}
+
+TEST(Gyro, TheOutputAngleIsMinusTwoDeltaThetaOverK) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  auto cfg = test_config();
+  CHECK(run_until(g, Mode::operate) > 0);
+  const double a0 = g.status().out_angle_rad;
+  // GIVEN the pattern turns by -1e-4 rad per frame for 1000 frames
+  chain.theta_rate_rad_per_block = -1e-4;
+  run(g, 1000);
+  // THEN the output turns by +2 * 0.1 / K = 0.4 rad
+  DOUBLES_EQUAL(0.4, g.status().out_angle_rad - a0, 1e-9);
+  DOUBLES_EQUAL(2e-4 / cfg.angular_gain * 1000.0, g.status().out_rate_rad_s, 1e-6);
+}
+
+TEST(Gyro, TheIdentifiedDriftIsAddedToTheOutput) {
+  auto cfg = test_config();
+  cfg.identify = false;
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  const double a0 = g.status().out_angle_rad;
+  ident.drift = 1e-3;  // rad/s, Omega K units
+  run(g, 1000);
+  DOUBLES_EQUAL(1e-3 / 0.5 * 1.0, g.status().out_angle_rad - a0, 1e-9);
+}
+
+TEST(Gyro, LossOfLockInOperateIsAFaultWithDrivesOffAndThenARetry) {
+  auto cfg = test_config();
+  cfg.identify = false;
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  chain.locked = false;
+  const int frames = run_until(g, Mode::fault, 100);
+  LONGS_EQUAL(50, frames);  // the monitor's 50-frame debounce
+  CHECK(g.mode_machine().faults() & fault_bit(Fault::loss_of_lock));
+  g.run_frame();
+  CHECK_FALSE(b.dac.driving(0));
+  CHECK_FALSE(g.status().out_valid);
+  chain.locked = true;
+  LONGS_EQUAL(99, run_until(g, Mode::ring_up, 200));  // 100 clean frames (one already counted)
+  LONGS_EQUAL(1, g.mode_machine().retries());
+}
+
+TEST(Gyro, AnAmplitudeCollapseInFreeDecayAbortsTheWindow) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::free_decay) > 0);
+  chain.decay_per_block = 0.2;  // the wave dies within a few frames
+  CHECK(run_until(g, Mode::fault, 50) > 0);
+  LONGS_EQUAL(1, ident.aborted);
+  LONGS_EQUAL(0, ident.ended);
+  CHECK(g.mode_machine().faults() & fault_bit(Fault::amplitude_collapse));
+}
+
+TEST(Gyro, AStuckAdcInPowerUpEndsInSafe) {
+  b.adc.set_stuck(true);
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::safe, 50) > 0);
+  CHECK(g.mode_machine().faults() & fault_bit(Fault::adc_stuck));
+  CHECK_FALSE(b.enable.level());
+}
+
+TEST(Gyro, ADacThatFailsSendsTheGyroToSafe) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::operate) > 0);
+  b.dac.set_status(hrg::hal::Status::io_error);
+  CHECK(run_until(g, Mode::safe, 5) > 0);
+  CHECK_FALSE(b.enable.level());
+}
+
+TEST(Gyro, TheBoardFaultInputSendsTheGyroToSafeAndOnlyARestartLeavesIt) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::lock) > 0);
+  b.fault_in.set_level(true);
+  g.run_frame();
+  g.run_frame();
+  CHECK(Mode::safe == g.status().mode);
+  b.fault_in.set_level(false);
+  run(g, 1000);
+  CHECK(Mode::safe == g.status().mode);
+  g.command_restart();
+  CHECK(run_until(g, Mode::operate) > 0);
+}
+
+TEST(Gyro, AnOverrunStormIsAFault) {
+  // A timer that, once switched to slow, advances 1 ms per reading: every task overruns.
+  struct SwitchableTimer final : hrg::hal::MonotonicClock {
+    mutable uint64_t t = 0;
+    bool slow = false;
+    uint64_t now_ns() const override { return slow ? (t += 1'000'000) : t; }
+    hrg::hal::Status sleep_until_ns(uint64_t) override { return hrg::hal::Status::ok; }
+  } timer2;
+  auto cfg = test_config();
+  cfg.identify = false;
+  Gyro g(b.board, chain, ident, timer2, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  timer2.slow = true;
+  // 16 overrun frames out of the last 64 make a storm; the monitor sees a
+  // frame's overruns in the next frame, so the 17th frame raises it
+  LONGS_EQUAL(17, run_until(g, Mode::fault, 100));
+  CHECK(g.mode_machine().faults() & fault_bit(Fault::overrun_storm));
+}
+
+TEST(Gyro, SkippedAdcBlocksAreCounted) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  run(g, 5);
+  b.adc.skip_blocks(3);
+  run(g, 5);
+  LONGS_EQUAL(3, g.status().adc_missed_blocks);
+}
+
+TEST(Gyro, APatternCommandMovesThePatternWithTheOutputHeld) {
+  auto cfg = test_config();
+  cfg.identify = false;
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  const double a0 = g.status().out_angle_rad;
+  g.command_pattern_angle(0.3);
+  run(g, 300);
+  DOUBLES_EQUAL(0.3, chain.theta(), 1e-9);
+  CHECK_FALSE(g.status().out_valid);
+  DOUBLES_EQUAL(a0, g.status().out_angle_rad, 1e-12);
+  g.release_pattern();
+  chain.theta_rate_rad_per_block = -1e-5;
+  run(g, 100);
+  CHECK(g.status().out_valid);
+  DOUBLES_EQUAL(a0 + 2e-3 / 0.5, g.status().out_angle_rad, 1e-4);
+}
+
+TEST(Gyro, ABoardWithAnotherBlockLayoutIsRefusedWithDrivesOff) {
+  b.adc.set_layout(100'000, 50);
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK_FALSE(g.board_ok());
+  run(g, 100);
+  CHECK(Mode::power_up == g.status().mode);
+  CHECK_FALSE(b.enable.level());
+}
