@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: MIT
+#include "dsp/chain.hpp"
+
+#include <cmath>
+
+namespace hrg::dsp {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+double clamp_abs(double v, double lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
+}  // namespace
+
+const char* check_chain_config(const ChainConfig& c) {
+  if (!(c.sample_rate_hz > 0.0)) return "chain config: sample_rate_hz must be > 0";
+  if (c.block_frames < 4 || c.block_frames > 2000)
+    return "chain config: block_frames must be in [4, 2000]";
+  if (!(c.adc_full_scale_v > 0.0)) return "chain config: adc_full_scale_v must be > 0";
+  if (!(c.dac_full_scale_v > 0.0)) return "chain config: dac_full_scale_v must be > 0";
+  if (!(c.dac_lead_frames >= 0.0 && c.dac_lead_frames < 1048576.0))
+    return "chain config: dac_lead_frames must be in [0, 2^20)";
+  if (!(c.f_min_hz > 0.0 && c.f_min_hz <= c.f_center_hz && c.f_center_hz <= c.f_max_hz &&
+        c.f_max_hz < c.sample_rate_hz / 2.0))
+    return "chain config: need 0 < f_min_hz <= f_center_hz <= f_max_hz < sample_rate_hz / 2";
+  if (!(c.q_factor > 0.0)) return "chain config: q_factor must be > 0";
+  if (!(c.pump_gain_per_s2_v2 > 0.0)) return "chain config: pump_gain_per_s2_v2 must be > 0";
+  if (!(c.forcer_gain_per_s2 > 0.0)) return "chain config: forcer_gain_per_s2 must be > 0";
+  if (!(c.amplitude_setpoint_v > 0.0 && c.amplitude_setpoint_v < c.adc_full_scale_v))
+    return "chain config: amplitude_setpoint_v must be in (0, adc_full_scale_v)";
+  if (!(c.pump_max_v > 0.0 && c.pump_max_v <= c.dac_full_scale_v))
+    return "chain config: pump_max_v must be in (0, dac_full_scale_v]";
+  if (!(c.forcer_max_v > 0.0 && c.forcer_max_v <= c.dac_full_scale_v))
+    return "chain config: forcer_max_v must be in (0, dac_full_scale_v]";
+  if (!(c.pll_natural_hz > 0.0 && c.pll_damping > 0.0))
+    return "chain config: pll_natural_hz and pll_damping must be > 0";
+  if (!(c.agc_natural_rad_s > 0.0 && c.agc_damping > 0.0))
+    return "chain config: agc_natural_rad_s and agc_damping must be > 0";
+  if (!(c.quad_natural_rad_s > 0.0 && c.quad_damping > 0.0))
+    return "chain config: quad_natural_rad_s and quad_damping must be > 0";
+  if (!(c.min_amplitude_v > 0.0)) return "chain config: min_amplitude_v must be > 0";
+  if (!(c.ring_up_enter >= 0.0 && c.ring_up_enter < c.ring_up_exit && c.ring_up_exit <= 1.0))
+    return "chain config: need 0 <= ring_up_enter < ring_up_exit <= 1";
+  if (!(c.lock_enter_rad > 0.0 && c.lock_enter_rad < c.lock_exit_rad))
+    return "chain config: need 0 < lock_enter_rad < lock_exit_rad";
+  return nullptr;
+}
+
+template <typename T>
+Chain<T>::Chain(const ChainConfig& cfg) : cfg_(cfg), demod_(cfg.block_frames) {
+  usable_ = check_chain_config(cfg) == nullptr;
+  if (!usable_) return;
+  const double w = 2.0 * kPi * cfg.f_center_hz;
+  pll_.configure(Pll::Config{cfg.f_center_hz, cfg.f_min_hz, cfg.f_max_hz, cfg.pll_natural_hz,
+                             cfg.pll_damping});
+  lock_.configure(cfg.lock_enter_rad, cfg.lock_exit_rad, cfg.lock_blocks, 0.05);
+  agc_.configure(Agc::Config{cfg.amplitude_setpoint_v, kPi * cfg.f_center_hz / cfg.q_factor,
+                             cfg.agc_natural_rad_s, cfg.agc_damping, w, cfg.pump_gain_per_s2_v2,
+                             cfg.pump_max_v});
+  // a_B' = b u_q with b = g / 2w: PI on -a_B in volts of forcer.
+  const double b = cfg.forcer_gain_per_s2 / (2.0 * w);
+  const double wn = cfg.quad_natural_rad_s;
+  quad_pi_.configure(2.0 * cfg.quad_damping * wn / b, wn * wn / b, -cfg.forcer_max_v,
+                     cfg.forcer_max_v);
+  reset();
+}
+
+template <typename T>
+void Chain<T>::reset() {
+  demod_.reset();
+  pll_.reset();
+  lock_.reset();
+  agc_.reset();
+  quad_pi_.reset();
+  unwrap_.reset();
+  out_ = ChainOutputs{};
+  phase_ = 0;
+  step_ = phase_step_of_hz(cfg_.f_center_hz, cfg_.sample_rate_hz);
+  excitation_ = false;
+  ring_up_ = true;
+  wave_phase_rad_ = 0.0;
+  c2_ = std::cos(2.0 * cfg_.ring_up_theta_rad);
+  s2_ = std::sin(2.0 * cfg_.ring_up_theta_rad);
+  u_a_v_ = u_q_v_ = u_r_v_ = v0_v_ = 0.0;
+}
+
+template <typename T>
+void Chain<T>::set_pattern_command(bool enabled, double theta_target_rad, double max_rate_rad_s) {
+  pattern_enabled_ = enabled;
+  pattern_target_rad_ = theta_target_rad;
+  pattern_max_rate_rad_s_ = std::fabs(max_rate_rad_s);
+}
+
+template <typename T>
+bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
+  if (!usable_) return false;
+  if (adc.size() != kChainAdcChannels * cfg_.block_frames) return false;
+  if (dac.size() != kChainDacChannels * cfg_.block_frames) return false;
+
+  const uint32_t phase_block_start = phase_;
+  QuadSample<T> qs;
+  demod_.process_block(adc, phase_, step_, qs);
+
+  const double fs_v = cfg_.adc_full_scale_v;
+  const Quadratures<double> q{Ops::to_f64(qs.cx) * fs_v, Ops::to_f64(qs.sx) * fs_v,
+                              Ops::to_f64(qs.cy) * fs_v, Ops::to_f64(qs.sy) * fs_v};
+  const WaveVariables<double> w = wave_variables(q);
+  out_.quad = q;
+  out_.wave = w;
+  out_.theta_A_rad = unwrap_.update(w.theta_A_rad);
+  out_.phase_err_rad = w.phase_rad;
+
+  const double dt_s = static_cast<double>(cfg_.block_frames) / cfg_.sample_rate_hz;
+  update_loops(w, dt_s);
+  step_ = phase_step_of_hz(out_.pll_freq_hz, cfg_.sample_rate_hz);
+  synthesize(phase_block_start, dac);
+  ++out_.blocks;
+  return true;
+}
+
+template <typename T>
+void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
+  const bool valid = w.a_A > cfg_.min_amplitude_v;
+  // Geometry of the drive: the pattern axis and the full wave phase (the
+  // sign of the projection on the axis resolves the pi ambiguity of phase_rad).
+  if (valid) {
+    c2_ = std::cos(2.0 * w.theta_A_rad);
+    s2_ = std::sin(2.0 * w.theta_A_rad);
+    const double c_a = out_.quad.cx * c2_ + out_.quad.cy * s2_;
+    const double s_a = out_.quad.sx * c2_ + out_.quad.sy * s2_;
+    wave_phase_rad_ = std::atan2(-s_a, c_a);
+  }
+  out_.pll_freq_hz = pll_.update(w.phase_rad, valid, dt_s);
+  out_.locked = lock_.update(w.phase_rad, valid);
+  out_.excitation = excitation_;
+
+  if (!excitation_) {
+    // Free decay: drives off, amplitude and quadrature loops hold their state.
+    u_a_v_ = u_q_v_ = u_r_v_ = v0_v_ = 0.0;
+  } else {
+    const double a_set = agc_.setpoint_v();
+    if (ring_up_ && w.a_A > cfg_.ring_up_exit * a_set) ring_up_ = false;
+    if (!ring_up_ && w.a_A < cfg_.ring_up_enter * a_set) ring_up_ = true;
+    if (ring_up_) {
+      // Direct drive at resonance along the pattern: the pump alone cannot
+      // start a wave from zero amplitude.
+      u_a_v_ = cfg_.forcer_max_v;
+      u_q_v_ = 0.0;
+      v0_v_ = valid ? cfg_.pump_max_v : 0.0;
+    } else {
+      u_a_v_ = 0.0;
+      v0_v_ = agc_.update(w.a_A, dt_s);
+      u_q_v_ = quad_pi_.update(-w.a_B, dt_s);
+    }
+    u_r_v_ = 0.0;
+    if (pattern_enabled_ && valid) {
+      const double w_rad_s = 2.0 * kPi * out_.pll_freq_hz;
+      const double rate =
+          clamp_abs(cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
+                    pattern_max_rate_rad_s_);
+      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2, cfg_.forcer_max_v);
+    }
+  }
+  out_.ring_up = ring_up_;
+  out_.pump_v = v0_v_;
+  out_.pump_phase_rad = wave_phase_rad_ + cfg_.pump_phase_rad;
+  out_.quad_effort_v = u_q_v_;
+  out_.pattern_effort_v = u_r_v_;
+  out_.ring_up_drive_v = u_a_v_;
+}
+
+template <typename T>
+void Chain<T>::synthesize(uint32_t phase_block_start, std::span<q31_t> dac) const {
+  const std::size_t n = cfg_.block_frames;
+  if (!excitation_) {
+    for (std::size_t j = 0; j < kChainDacChannels * n; ++j)
+      dac[j] = 0;
+    return;
+  }
+  const double inv_fs = 1.0 / cfg_.dac_full_scale_v;
+  auto coef = [inv_fs](double v) -> T {
+    if constexpr (Ops::kFixed) {
+      return q31_from_f64_sat(v * inv_fs);
+    } else {
+      return static_cast<T>(v * inv_fs);
+    }
+  };
+  // Forcer x = A cos psi + B sin psi, forcer y = C cos psi + D sin psi.
+  const T pump = coef(v0_v_);
+  const T fxc = coef(-u_q_v_ * s2_);
+  const T fxs = coef(-u_a_v_ * c2_ + u_r_v_ * s2_);
+  const T fyc = coef(u_q_v_ * c2_);
+  const T fys = coef(-u_a_v_ * s2_ - u_r_v_ * c2_);
+  // Phase advance over the DAC lead, modulo one turn (exact for leads of up
+  // to 2^20 frames).
+  const auto lead = static_cast<uint32_t>(
+      static_cast<uint64_t>(static_cast<double>(step_) * cfg_.dac_lead_frames + 0.5));
+  const uint32_t psi0 = phase_block_start + lead + phase_of_rad(wave_phase_rad_);
+  const uint32_t pump_off = phase_of_rad(cfg_.pump_phase_rad);
+  uint32_t psi = psi0;
+  q31_t* d = dac.data();
+  for (std::size_t j = 0; j < n; ++j) {
+    const T c = cos_turns<T>(psi);
+    const T s = sin_turns<T>(psi);
+    const T cp = cos_turns<T>(psi + pump_off);
+    d[3 * j] = Ops::to_q31(Ops::mul(pump, cp));
+    d[3 * j + 1] = Ops::to_q31(Ops::add(Ops::mul(fxc, c), Ops::mul(fxs, s)));
+    d[3 * j + 2] = Ops::to_q31(Ops::add(Ops::mul(fyc, c), Ops::mul(fys, s)));
+    psi += step_;
+  }
+}
+
+template class Chain<q31_t>;
+template class Chain<float>;
+template class Chain<double>;
+
+}  // namespace hrg::dsp

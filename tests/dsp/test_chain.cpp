@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: MIT
+// Chain without a resonator: interface contracts (sizes, configuration
+// errors, drives exactly zero when excitation is off, loop elements).
+#include "dsp/chain.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <vector>
+
+#include "support/cpputest.hpp"
+
+using namespace hrg::dsp;
+
+namespace {
+std::vector<q31_t> tone_block(uint32_t frames, double f_hz, double a, double t0_s) {
+  std::vector<q31_t> v(2 * frames);
+  for (uint32_t n = 0; n < frames; ++n) {
+    const double t = t0_s + n / 100000.0;
+    v[2 * n] = q31_from_f64_sat(a * std::cos(2 * std::numbers::pi * f_hz * t));
+    v[2 * n + 1] = 0;
+  }
+  return v;
+}
+}  // namespace
+
+TEST_GROUP(ChainConfig){};
+
+TEST(ChainConfig, DefaultsAreUsableAndBadFieldsAreNamed) {
+  CHECK(check_chain_config(ChainConfig{}) == nullptr);
+  ChainConfig c;
+  c.block_frames = 1;
+  STRCMP_CONTAINS("block_frames", check_chain_config(c));
+  c = ChainConfig{};
+  c.f_max_hz = 4000.0;
+  STRCMP_CONTAINS("f_max_hz", check_chain_config(c));
+  c = ChainConfig{};
+  c.pump_max_v = 20.0;
+  STRCMP_CONTAINS("pump_max_v", check_chain_config(c));
+  c = ChainConfig{};
+  c.ring_up_exit = 0.05;
+  STRCMP_CONTAINS("ring_up", check_chain_config(c));
+}
+
+TEST(ChainConfig, AnUnusableConfigurationMakesProcessRefuse) {
+  ChainConfig c;
+  c.adc_full_scale_v = -1.0;
+  Chain<q31_t> chain(c);
+  std::vector<q31_t> adc(200, 0), dac(300, 7);
+  CHECK_FALSE(chain.process(adc, dac));
+  CHECK_EQUAL(7, dac[0]);
+}
+
+TEST_GROUP(Chain){};
+
+TEST(Chain, RefusesBlocksOfTheWrongSize) {
+  Chain<q31_t> chain(ChainConfig{});
+  std::vector<q31_t> adc(200, 0), dac(300, 0), short_adc(198, 0), short_dac(297, 0);
+  CHECK_FALSE(chain.process(short_adc, dac));
+  CHECK_FALSE(chain.process(adc, short_dac));
+  CHECK_EQUAL(0u, chain.outputs().blocks);
+  CHECK(chain.process(adc, dac));
+  CHECK_EQUAL(1u, chain.outputs().blocks);
+}
+
+TEST(Chain, DrivesAreExactlyZeroWhileExcitationIsOff) {
+  // GIVEN a strong resonance signal and a chain whose loops would drive hard
+  Chain<q31_t> chain(ChainConfig{});
+  Chain<float> chain_f(ChainConfig{});
+  std::vector<q31_t> dac(300, 12345), dac_f(300, 12345);
+  for (int b = 0; b < 50; ++b) {
+    const auto adc = tone_block(100, 5000.0, 0.3, b * 1e-3);
+    chain.process(adc, dac);
+    chain_f.process(adc, dac_f);
+    // THEN every DAC word is 0 while excitation is off
+    for (std::size_t k = 0; k < dac.size(); ++k) {
+      CHECK_EQUAL(0, dac[k]);
+      CHECK_EQUAL(0, dac_f[k]);
+    }
+  }
+  // and the measurement still runs (the wave is seen, the PLL tracks it)
+  DOUBLES_EQUAL(0.3 * 2.0, chain.outputs().wave.a_A, 1e-4);
+  // WHEN excitation is switched on the pump comes on
+  chain.set_excitation(true);
+  chain.process(tone_block(100, 5000.0, 0.3, 0.05), dac);
+  bool any = false;
+  for (q31_t v : dac)
+    any = any || v != 0;
+  CHECK(any);
+  // and off again: zero from the very next block
+  chain.set_excitation(false);
+  chain.process(tone_block(100, 5000.0, 0.3, 0.051), dac);
+  for (q31_t v : dac)
+    CHECK_EQUAL(0, v);
+}
+
+TEST(Chain, RingsUpAlongTheCommandedAngleFromRest) {
+  // GIVEN silence and excitation on
+  ChainConfig c;
+  c.ring_up_theta_rad = std::numbers::pi / 8;  // 22.5 deg: forcers x and y equal
+  Chain<double> chain(c);
+  chain.set_excitation(true);
+  std::vector<q31_t> adc(200, 0), dac(300, 0);
+  chain.process(adc, dac);
+  // THEN the pump is off (nothing to pump) and the forcers drive along the
+  // pattern with amplitude forcer_max at the NCO frequency
+  CHECK(chain.outputs().ring_up);
+  double px = 0, fx = 0, fy = 0;
+  for (int j = 0; j < 100; ++j) {
+    // rms over the block's 5 whole periods
+    px += std::pow(f64_from_q31(dac[3 * j]), 2) / 100.0;
+    fx += std::pow(f64_from_q31(dac[3 * j + 1]), 2) / 100.0;
+    fy += std::pow(f64_from_q31(dac[3 * j + 2]), 2) / 100.0;
+  }
+  fx = std::sqrt(2.0 * fx);
+  fy = std::sqrt(2.0 * fy);
+  DOUBLES_EQUAL(0.0, px, 0.0);
+  const double expect = c.forcer_max_v / c.dac_full_scale_v * std::cos(std::numbers::pi / 4);
+  DOUBLES_EQUAL(expect, fx, 1e-5);
+  DOUBLES_EQUAL(expect, fy, 1e-5);
+}
+
+TEST_GROUP(Loops){};
+
+TEST(Loops, PiIntegratorDoesNotWindUpAgainstALimit) {
+  PiController pi;
+  pi.configure(1.0, 100.0, -1.0, 1.0);
+  for (int k = 0; k < 1000; ++k)
+    pi.update(10.0, 1e-3);  // pushes hard into +1
+  DOUBLES_EQUAL(1.0, pi.output(), 0.0);
+  CHECK(pi.integrator() <= 1.0);
+  // the first small negative error brings the output off the limit at once
+  pi.update(-0.5, 1e-3);
+  CHECK(pi.output() < 1.0);
+}
+
+TEST(Loops, LockDetectorHasHysteresis) {
+  LockDetector d;
+  d.configure(0.01, 0.05, 10, 1.0);  // no smoothing: level = |error|
+  d.reset();
+  for (int k = 0; k < 9; ++k)
+    CHECK_FALSE(d.update(0.005, true));
+  CHECK(d.update(0.005, true));  // 10th block below enter
+  CHECK(d.update(0.03, true));   // between enter and exit: stays locked
+  CHECK_FALSE(d.update(0.06, true));
+  CHECK_FALSE(d.update(0.03, true));  // between: stays unlocked
+  CHECK_FALSE(d.update(0.0, false));
+}
+
+TEST(Loops, PllRampErrorIsRampOverNaturalFrequencySquared) {
+  // Type-2 loop against the plant phi' = w_res - w_nco, resonance ramping at
+  // 0.5 Hz/s: steady phase error r / wn^2.
+  Pll pll;
+  Pll::Config c;
+  c.natural_hz = 12.0;
+  pll.configure(c);
+  const double dt = 1e-3, r = 2 * std::numbers::pi * 0.5;
+  double phi = 0.0, w_res = 2 * std::numbers::pi * 5000.0;
+  for (int k = 0; k < 4000; ++k) {
+    const double f = pll.update(phi, true, dt);
+    w_res += r * dt;
+    phi += (w_res - 2 * std::numbers::pi * f) * dt;
+  }
+  const double wn = 2 * std::numbers::pi * 12.0;
+  DOUBLES_EQUAL(r / (wn * wn), phi, 0.05 * r / (wn * wn));
+}
+
+TEST(Loops, PllStaysWithinItsFrequencyLimits) {
+  Pll pll;
+  pll.configure(Pll::Config{5000.0, 4999.0, 5001.0, 12.0, 0.9});
+  for (int k = 0; k < 5000; ++k)
+    pll.update(1.0, true, 1e-3);
+  DOUBLES_EQUAL(5001.0, pll.frequency_hz(), 1e-9);
+  CHECK(pll.at_limit());
+  pll.update(-1.0, true, 1e-3);  // no wind-up: leaves the limit at once
+  CHECK(pll.frequency_hz() < 5001.0);
+}
