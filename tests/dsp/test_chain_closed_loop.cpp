@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: MIT
+// The chain closing its loops on the full-rate simulated resonator
+// (sim_target, default resonator: 5 kHz, Q 5e6, split 5e-4 Hz, dQ/Q 0.1).
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "chain_rig.hpp"
+#include "dsp/wave_variables.hpp"
+#include "sim_target/params.hpp"
+
+#include "support/cpputest.hpp"
+
+using namespace hrg::dsp;
+using namespace hrg::dsp::test;
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// True wave variables of the simulated resonator (its analytic envelopes).
+WaveVariables<double> true_wave(hrg::sim::Resonator& r) {
+  std::complex<double> x, y;
+  r.envelopes(x, y);
+  // X = cx - i sx
+  return wave_variables(Quadratures<double>{x.real(), -x.imag(), y.real(), -y.imag()});
+}
+}  // namespace
+
+TEST_GROUP(ClosedLoop){};
+
+TEST(ClosedLoop, PllAcquiresFromTwoHertzOffInUnderTwoSecondsOverAGrid) {
+  double worst_lock_s = 0.0;
+  for (double offset_hz : {-2.0, -1.0, 1.0, 2.0}) {
+    for (double theta : {0.0, 17.0 * kDeg, 40.0 * kDeg, -29.0 * kDeg}) {
+      // GIVEN a ringing wave and an NCO that starts offset_hz away from it
+      ChainConfig cfg = rig_config();
+      cfg.f_center_hz = 5000.0 + offset_hz;
+      ChainRig<q31_t> rig(cfg);
+      rig.resonator().set_standing_wave(1.0, theta, 0.0, 0.3);
+      rig.chain().set_excitation(true);
+      // WHEN the loops run
+      double lock_s = -1.0;
+      rig.run(2.0, [&] {
+        if (lock_s < 0.0 && rig.out().locked) lock_s = rig.time_s();
+      });
+      // THEN lock is declared before 2 s, on the resonance (within the
+      // half-split 2.5e-4 Hz of 5 kHz), with a sub-mrad phase error
+      CHECK(lock_s > 0.0 && lock_s < 2.0);
+      DOUBLES_EQUAL(5000.0, rig.out().pll_freq_hz, 5e-4);
+      CHECK(std::fabs(rig.out().phase_err_rad) < 1e-3);
+      worst_lock_s = std::fmax(worst_lock_s, lock_s);
+    }
+  }
+  std::printf("\n  PLL acquisition from +-1, +-2 Hz: worst time to lock %.3f s\n", worst_lock_s);
+}
+
+TEST(ClosedLoop, PllTracksAHalfHertzPerSecondRampWithinOneMilliradian) {
+  // GIVEN a resonance that ramps at 0.5 Hz/s (thermal frequency shift of
+  // 100 ppm/degC with the temperature ramping at 1 degC/s for 4 s)
+  hrg::sim::Effects fx;
+  fx.thermal_frequency.enabled = true;
+  fx.thermal_frequency.ppm_per_c = 100.0;
+  ChainRig<q31_t> rig(rig_config(), {}, {}, fx);
+  rig.resonator().set_temperature_profile(hrg::sim::Profile::ramps({{1.0, 25.0}, {5.0, 29.0}}));
+  rig.resonator().set_standing_wave(1.0, 0.2);
+  rig.chain().set_excitation(true);
+  // WHEN the loops run through the ramp
+  double worst = 0.0;
+  rig.run(5.0, [&] {
+    if (rig.time_s() > 1.5) worst = std::fmax(worst, std::fabs(rig.out().phase_err_rad));
+  });
+  // THEN the phase error stays below 1 mrad (type-2 loop: r / wn^2 = 0.55 mrad)
+  const double predicted = 2 * kPi * 0.5 / std::pow(2 * kPi * 12.0, 2);
+  std::printf("\n  PLL on a 0.5 Hz/s ramp: max |phase error| %.3e rad (r/wn^2 = %.3e)\n", worst,
+              predicted);
+  CHECK(worst < 1e-3);
+  DOUBLES_EQUAL(predicted, worst, 0.3 * predicted);
+  CHECK(rig.out().locked);
+  DOUBLES_EQUAL(5002.0, rig.out().pll_freq_hz, 0.01);
+}
+
+TEST(ClosedLoop, AgcHoldsTheAmplitudeAndQuadratureIsNulledInSteadyState) {
+  double worst_a = 0.0, worst_q = 0.0, worst_true_q = 0.0, worst_v0 = 0.0;
+  const hrg::sim::ResonatorParams rp;
+  const hrg::sim::ElectrodeParams ep;
+  for (double theta : {0.0, 11.25 * kDeg, 22.5 * kDeg, 33.0 * kDeg, -20.0 * kDeg}) {
+    // GIVEN the default resonator ringing at 0.9 V with some quadrature at theta
+    ChainRig<q31_t> rig(rig_config());
+    rig.resonator().set_standing_wave(0.95, theta, 0.01, 0.0);
+    rig.chain().set_excitation(true);
+    rig.run(3.0);
+    // WHEN the loops have settled, over the next 3 s
+    rig.run(3.0, [&] {
+      const auto& w = rig.out().wave;
+      worst_a = std::fmax(worst_a, std::fabs(w.a_A - 1.0));
+      worst_q = std::fmax(worst_q, std::fabs(w.a_B / w.a_A));
+      const auto t = true_wave(rig.resonator());
+      worst_true_q = std::fmax(worst_true_q, std::fabs(t.a_B / t.a_A));
+    });
+    // and the pump works at its best phase: V0 is the parametric threshold
+    // sqrt(8 w nu_A / k_pump) of wave A (nu_A = nu (1 + dmu cos 4theta)),
+    // raised by the zero-order hold's loss at 2f, sin(x)/x with x = 2 pi f / fs
+    const double nu_a = rp.nu_per_s() * (1.0 + rp.dmu * std::cos(4.0 * theta));
+    const double x = 2.0 * kPi * 5000.0 / 100000.0;
+    const double v0 = ep.threshold_v(rp.omega_rad_s(), nu_a) / std::sqrt(std::sin(x) / x);
+    worst_v0 = std::fmax(worst_v0, std::fabs(rig.out().pump_v / v0 - 1.0));
+  }
+  CHECK(worst_v0 < 1e-3);
+  // THEN a_A stays within 1e-4 of the set point and |a_B| below 1e-4 a_A,
+  // as measured and in the resonator itself
+  std::printf(
+      "\n  steady state: max |a_A/a_set - 1| %.2e, max |a_B/a_A| %.2e (true %.2e), "
+      "V0 vs threshold %.1e\n",
+      worst_a, worst_q, worst_true_q, worst_v0);
+  CHECK(worst_a < 1e-4);
+  CHECK(worst_q < 1e-4);
+  CHECK(worst_true_q < 1e-4);
+}
+
+TEST(ClosedLoop, LoopsRecoverWithinOneSecondAfterATwoSecondFreeDecayWindow) {
+  double worst_settle_s = 0.0, worst_overshoot = 0.0, worst_decay = 0.0, worst_growth = 0.0;
+  for (double theta : {22.5 * kDeg, -22.5 * kDeg, 5.0 * kDeg, 40.0 * kDeg}) {
+    // GIVEN settled loops
+    ChainRig<q31_t> rig(rig_config());
+    rig.resonator().set_standing_wave(1.0, theta);
+    rig.chain().set_excitation(true);
+    rig.run(3.0);
+    // WHEN excitation is off for 2 s, a_A decays and a_B grows freely
+    rig.chain().set_excitation(false);
+    rig.run(2.0);
+    const auto& w = rig.out().wave;
+    worst_decay = std::fmax(worst_decay, 1.0 - w.a_A);
+    worst_growth = std::fmax(worst_growth, std::fabs(w.a_B / w.a_A));
+    // THEN, with excitation back on, the loops settle within 1 s
+    rig.chain().set_excitation(true);
+    const double t_on = rig.time_s();
+    double last_bad_s = 0.0, overshoot = 0.0;
+    rig.run(1.5, [&] {
+      const auto& o = rig.out().wave;
+      overshoot = std::fmax(overshoot, o.a_A - 1.0);
+      if (std::fabs(o.a_A - 1.0) > 1e-4 || std::fabs(o.a_B / o.a_A) > 1e-4)
+        last_bad_s = rig.time_s() - t_on;
+    });
+    CHECK(last_bad_s < 1.0);
+    CHECK(overshoot < 1e-3);
+    worst_settle_s = std::fmax(worst_settle_s, last_bad_s);
+    worst_overshoot = std::fmax(worst_overshoot, overshoot);
+  }
+  // The window really disturbed the wave: a_A fell by about 2 nu = 6.3e-3 and
+  // a_B grew to about 2 dw a_A = 3.1e-3 a_A where sin 4(theta - th_w) = 1.
+  std::printf(
+      "\n  free decay 2 s: a_A fell %.2e, a_B/a_A grew to %.2e; recovery %.3f s, overshoot "
+      "%.2e a_set\n",
+      worst_decay, worst_growth, worst_settle_s, worst_overshoot);
+  CHECK(worst_decay > 5e-3);
+  CHECK(worst_growth > 2e-3);
+}
+
+TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
+  // GIVEN the resonator at rest and a small set point (ring-up is slow: the
+  // 5 V forcer drive raises a_A by g u / 2w = 0.016 V/s)
+  ChainConfig cfg = rig_config();
+  cfg.amplitude_setpoint_v = 0.05;
+  cfg.ring_up_theta_rad = 10.0 * kDeg;
+  ChainRig<q31_t> rig(cfg);
+  rig.chain().set_excitation(true);
+  // WHEN the chain runs
+  double handover_s = -1.0;
+  rig.run(12.0, [&] {
+    if (handover_s < 0.0 && !rig.out().ring_up) handover_s = rig.time_s();
+  });
+  // THEN the direct drive brought the wave to 0.9 a_set (at ~2.8 s, ideal
+  // 0.045 V / 0.0159 V/s), the pump (growth up to k 10^2 / 8w - nu = 0.032/s)
+  // took it to the set point and holds it there along the commanded angle
+  std::printf("\n  ring-up from rest to 0.9 a_set: %.3f s; a_A %.6f V\n", handover_s,
+              rig.out().wave.a_A);
+  CHECK(handover_s > 2.5 && handover_s < 3.5);
+  DOUBLES_EQUAL(0.05, rig.out().wave.a_A, 0.05 * 1e-4);
+  DOUBLES_EQUAL(10.0 * kDeg, rig.out().theta_A_rad, 1e-3);
+  CHECK(rig.out().locked);
+}
+
+TEST(ClosedLoop, PatternFollowsTheInputRateWithAllLoopsClosed) {
+  // GIVEN 100 deg/s about the sensitive axis and all loops closed
+  const double omega = 100.0 * kDeg;
+  const hrg::sim::ResonatorParams rp;
+  ChainRig<q31_t> rig(rig_config(), rp);
+  rig.resonator().set_rate_profile(hrg::sim::Profile::constant(omega));
+  rig.resonator().set_standing_wave(1.0, 0.1);
+  rig.chain().set_excitation(true);
+  rig.run(1.0);
+  // WHEN theta_A is followed over exactly 3 periods of 4 theta (3 pi/2 rad of
+  // pattern angle), start and end interpolated between blocks
+  const double expected = -rp.angular_gain * omega / 2.0;
+  const double th0 = rig.out().theta_A_rad - 0.01;
+  const double th1 = th0 - 3.0 * kPi / 2.0;
+  double t0 = -1, t1 = -1, prev_t = rig.time_s(), prev_th = rig.out().theta_A_rad;
+  double worst_a = 0.0, worst_q = 0.0;
+  rig.run(12.0, [&] {
+    const double t = rig.time_s(), th = rig.out().theta_A_rad;
+    if (t0 < 0 && th <= th0) t0 = prev_t + (t - prev_t) * (th0 - prev_th) / (th - prev_th);
+    if (t1 < 0 && th <= th1) t1 = prev_t + (t - prev_t) * (th1 - prev_th) / (th - prev_th);
+    worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
+    worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
+    prev_t = t;
+    prev_th = th;
+  });
+  CHECK(t0 > 0 && t1 > t0);
+  const double rate = (th1 - th0) / (t1 - t0);
+  // THEN the mean rate is -K Omega / 2 within 1e-5 relative
+  std::printf(
+      "\n  100 deg/s: theta_A' = %.8f rad/s, -K Omega/2 = %.8f, rel. error %.2e; "
+      "|a_A - 1| %.1e, |a_B| %.1e\n",
+      rate, expected, rate / expected - 1.0, worst_a, worst_q);
+  DOUBLES_EQUAL(expected, rate, 1e-5 * std::fabs(expected));
+  CHECK(worst_a < 1e-4);
+  CHECK(worst_q < 1e-4);
+}
+
+TEST(ClosedLoop, FloatAndFixedChainsAgreeOnThetaWithinOneMicroradianRms) {
+  // GIVEN 60 s of the default resonator under the fixed-point chain's loops,
+  // turning at 10 deg/s so theta_A covers 4theta twice
+  ChainRig<q31_t> rig(rig_config());
+  rig.resonator().set_rate_profile(hrg::sim::Profile::constant(10.0 * kDeg));
+  rig.resonator().set_standing_wave(1.0, 0.3);
+  rig.chain().set_excitation(true);
+  // WHEN a float chain and a double chain see the same ADC blocks
+  Chain<float> chain_f(rig_config());
+  Chain<double> chain_d(rig_config());
+  std::vector<q31_t> dac(300);
+  double sum_sq = 0.0, sum_sq_d = 0.0;
+  long n = 0;
+  rig.run(60.0, [&] {
+    chain_f.process(rig.last_adc(), dac);
+    chain_d.process(rig.last_adc(), dac);
+    if (rig.time_s() < 0.1) return;
+    const double d = chain_f.outputs().theta_A_rad - rig.out().theta_A_rad;
+    const double dd = chain_d.outputs().theta_A_rad - rig.out().theta_A_rad;
+    sum_sq += d * d;
+    sum_sq_d += dd * dd;
+    ++n;
+  });
+  const double rms = std::sqrt(sum_sq / static_cast<double>(n));
+  const double rms_d = std::sqrt(sum_sq_d / static_cast<double>(n));
+  std::printf("\n  theta_A over 60 s: float - fixed %.2e rad rms, double - fixed %.2e rad rms\n",
+              rms, rms_d);
+  // THEN they agree within 1e-6 rad rms
+  CHECK(rms < 1e-6);
+  CHECK(rms_d < 1e-6);
+  CHECK(std::fabs(rig.out().theta_A_rad - 0.3) > 2.0);  // the pattern really turned
+}
