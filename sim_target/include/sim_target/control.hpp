@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Back door of the simulated target (namespace hrg::sim). Tests and the host
+// tools use it to configure the board, steer the inputs, inject faults and
+// read the true state; the firmware only sees hrg::hal::board() and never
+// includes this header.
+//
+// Lockstep: simulated time advances only inside Adc::read_block, which
+// integrates the resonator over one block with the drive the firmware queued
+// through Dac::write_block (output one block later, plus latency_samples).
+// Within a block, ADC frame n samples the pickoffs at t_n = n / fs and DAC
+// frame n is held over [t_n, t_n+1). When the excitation-enable line is low
+// the drive amplifiers output zero.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "hal/board.hpp"
+#include "sim_target/converters.hpp"
+#include "sim_target/noise.hpp"
+#include "sim_target/resonator.hpp"
+#include "sim_target/sim_can.hpp"
+#include "sim_target/sim_config.hpp"
+
+namespace hrg::sim {
+
+// What really happens, for end-to-end checks.
+struct TrueState {
+  double t_s = 0.0;
+  double pattern_angle_rad = 0.0;  // theta_A, unwrapped since configure()
+  double input_angle_rad = 0.0;    // integral of Omega since configure()
+  double energy_v2 = 0.0;          // E = a_A^2 + a_B^2
+  double a_a_v = 0.0;
+  double a_b_v = 0.0;
+  double rate_rad_s = 0.0;
+  double temp_c = 0.0;
+  bool excitation_enabled = false;
+  double pump_v = 0.0;  // last pump voltage at the electrode
+};
+
+struct SimCounters {
+  uint64_t blocks = 0;
+  uint64_t adc_clipped = 0;    // ADC samples at a rail
+  uint64_t dac_saturated = 0;  // DAC samples at a rail
+  uint64_t dac_underruns = 0;  // DAC frames output as zero because no block was queued
+};
+
+class SimTarget {
+ public:
+  SimTarget();
+  SimTarget(const SimTarget&) = delete;
+  SimTarget& operator=(const SimTarget&) = delete;
+
+  // Resets everything (resonator state, converters, noise, CAN, time) to `c`.
+  void configure(const SimConfig& c);
+  const SimConfig& config() const { return config_; }
+  hal::Board& board() { return board_; }
+
+  // Inputs and parameters; take effect from the next sample.
+  void set_rate_profile(Profile rate_rad_s);
+  void set_temperature_profile(Profile temp_c);
+  void set_params(const ResonatorParams& p);
+  void set_electrodes(const ElectrodeParams& e);
+  void set_effects(const Effects& fx);
+
+  // Faults. Channels: ADC 0 = x, 1 = y; DAC 0 = pump, 1 = forcer x, 2 = forcer y.
+  void set_adc_stuck(std::size_t channel, bool stuck);          // repeats the last word
+  void set_adc_saturated(std::size_t channel, bool saturated);  // at the positive rail
+  void set_dac_dead(std::size_t channel, bool dead);            // outputs 0 V
+  void noise_burst(double rms_v, double duration_s);  // extra white noise on both ADC channels
+  void set_fault_input(bool active) { fault_input_.value = active; }
+
+  TrueState true_state() const;
+  SimCounters counters() const { return counters_; }
+  Resonator& resonator() { return resonator_; }
+  SimCan& can() { return can_; }
+  double time_s() const;
+
+ private:
+  struct SimAdc final : hal::Adc {
+    SimTarget* t;
+    explicit SimAdc(SimTarget* owner) : t(owner) {}
+    hal::ConverterInfo info() const override;
+    hal::Status read_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+                           uint32_t& clipped) override;
+  };
+  struct SimDac final : hal::Dac {
+    SimTarget* t;
+    explicit SimDac(SimTarget* owner) : t(owner) {}
+    hal::ConverterInfo info() const override;
+    hal::Status write_block(std::span<const hal::sample_q31> frames) override;
+  };
+  struct SimExcitation final : hal::DigitalOut {
+    bool value = false;
+    hal::Status write(bool active) override {
+      value = active;
+      return hal::Status::ok;
+    }
+  };
+  struct SimFaultIn final : hal::DigitalIn {
+    bool value = false;
+    hal::Status read(bool& active) override {
+      active = value;
+      return hal::Status::ok;
+    }
+  };
+  struct SimClock final : hal::MonotonicClock {
+    SimTarget* t;
+    explicit SimClock(SimTarget* owner) : t(owner) {}
+    uint64_t now_ns() const override;
+    hal::Status sleep_until_ns(uint64_t t_ns) override;
+  };
+  using DacFrame = std::array<hal::sample_q31, hal::kDacChannels>;
+
+  hal::Status produce_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+                            uint32_t& clipped);
+  Drive next_drive();
+  uint64_t sample_time_ns(uint64_t index) const;
+
+  SimConfig config_;
+  Resonator resonator_;
+  AdcQuantizer adc_q_;
+  DacQuantizer dac_q_;
+  detail::Gaussian noise_;
+  SimCan can_;
+  SimAdc adc_{this};
+  SimDac dac_{this};
+  SimExcitation excitation_;
+  SimFaultIn fault_input_;
+  SimClock clock_{this};
+  hal::Board board_;
+
+  uint64_t sample_index_ = 0;
+  // Queued DAC frames [dac_head_, end) and the latency line (ring); plain
+  // vectors so that configure() can release every allocation.
+  std::vector<DacFrame> dac_queue_;
+  std::size_t dac_head_ = 0;
+  std::vector<DacFrame> dac_latency_;
+  std::size_t latency_pos_ = 0;
+  bool dac_written_ = false;
+  std::array<bool, 2> adc_stuck_{};
+  std::array<bool, 2> adc_saturated_{};
+  std::array<hal::sample_q31, 2> adc_last_{};
+  std::array<bool, hal::kDacChannels> dac_dead_{};
+  double burst_rms_v_ = 0.0;
+  double burst_left_s_ = 0.0;
+  double pattern_angle_rad_ = 0.0;
+  double last_theta_rad_ = 0.0;
+  double input_angle_rad_ = 0.0;
+  double last_pump_v_ = 0.0;
+  SimCounters counters_;
+};
+
+// The instance behind hrg::hal::board() (configured with SimConfig{} on first use).
+SimTarget& target();
+
+}  // namespace hrg::sim

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Everything that configures the simulated target: resonator, electrodes,
+// effects, converters, noise, input profiles and the seed. Built in code by
+// tests, or from a TOML scenario by hrg_sim_scenario (host tools only).
+
+#include <array>
+#include <cstdint>
+
+#include "sim_target/params.hpp"
+#include "sim_target/profile.hpp"
+
+namespace hrg::sim {
+
+// Pickoff ADC (two channels: x = C, y = D).
+struct AdcConfig {
+  uint32_t sample_rate_hz = 100'000;
+  uint32_t block_frames = 100;
+  uint32_t bits = 24;                   // left-justified into Q1.31
+  double full_scale_v = 2.5;            // volts for Q1.31 = 1.0
+  std::array<double, 2> noise_v_rms{};  // white noise per sample, per channel
+  std::array<double, 2> offset_v{};     // added before quantisation
+};
+
+// Drive DAC (three channels: pump, forcer x, forcer y); same rate and block as the ADC.
+struct DacConfig {
+  uint32_t bits = 16;
+  double full_scale_v = 10.0;    // volts at the electrode for Q1.31 = 1.0
+  uint32_t latency_samples = 0;  // extra pipeline delay after the one-block double buffer
+};
+
+// In-memory CAN controller model.
+struct CanConfig {
+  uint32_t tx_queue_frames = 32;
+  uint32_t tx_frames_per_ms = 8;  // frames leaving the queue per millisecond (about 1 Mbit/s)
+};
+
+// Resonator state at t = 0.
+struct InitialWave {
+  double amplitude_v = 0.0;  // a_A
+  double theta_rad = 0.0;    // pattern angle (physical)
+  double quad_v = 0.0;       // a_B
+};
+
+struct SimConfig {
+  ResonatorParams resonator;
+  ElectrodeParams electrodes;
+  Effects effects;
+  AdcConfig adc;
+  DacConfig dac;
+  CanConfig can;
+  Profile rate_rad_s = Profile::constant(0.0);
+  Profile temp_c = Profile::constant(25.0);
+  InitialWave initial;
+  uint64_t seed = 1;  // fixes every noise source: same seed, same bits
+};
+
+}  // namespace hrg::sim

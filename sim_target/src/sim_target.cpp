@@ -1,0 +1,235 @@
+// SPDX-License-Identifier: MIT
+#include "sim_target/control.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "sim_target/averaged_model.hpp"
+
+namespace hrg::sim {
+
+using hal::Status;
+
+SimTarget::SimTarget() : board_{adc_, dac_, excitation_, fault_input_, can_, clock_} {
+  configure(SimConfig{});
+}
+
+void SimTarget::configure(const SimConfig& c) {
+  if (c.adc.sample_rate_hz == 0 || c.adc.block_frames == 0) {
+    throw std::invalid_argument("adc: sample_rate_hz and block_frames must be positive");
+  }
+  config_ = SimConfig(c);  // move-assign: releases the previous profiles' storage
+  resonator_ = Resonator(c.resonator, c.electrodes, c.effects);
+  resonator_.set_rate_profile(c.rate_rad_s);
+  resonator_.set_temperature_profile(c.temp_c);
+  resonator_.set_standing_wave(c.initial.amplitude_v, c.initial.theta_rad, c.initial.quad_v);
+  adc_q_ = AdcQuantizer(c.adc);
+  dac_q_ = DacQuantizer(c.dac);
+  noise_.reseed(c.seed);
+  can_.configure(c.can);
+  excitation_.value = false;
+  fault_input_.value = false;
+  sample_index_ = 0;
+  std::vector<DacFrame>().swap(dac_queue_);
+  dac_head_ = 0;
+  std::vector<DacFrame>(c.dac.latency_samples, DacFrame{}).swap(dac_latency_);
+  latency_pos_ = 0;
+  dac_written_ = false;
+  adc_stuck_ = {};
+  adc_saturated_ = {};
+  adc_last_ = {};
+  dac_dead_ = {};
+  burst_rms_v_ = 0.0;
+  burst_left_s_ = 0.0;
+  pattern_angle_rad_ = c.initial.theta_rad;
+  last_theta_rad_ = c.initial.theta_rad;
+  input_angle_rad_ = 0.0;
+  last_pump_v_ = 0.0;
+  counters_ = {};
+}
+
+void SimTarget::set_rate_profile(Profile rate_rad_s) {
+  config_.rate_rad_s = rate_rad_s;
+  resonator_.set_rate_profile(std::move(rate_rad_s));
+}
+void SimTarget::set_temperature_profile(Profile temp_c) {
+  config_.temp_c = temp_c;
+  resonator_.set_temperature_profile(std::move(temp_c));
+}
+void SimTarget::set_params(const ResonatorParams& p) {
+  config_.resonator = p;
+  resonator_.set_params(p);
+}
+void SimTarget::set_electrodes(const ElectrodeParams& e) {
+  config_.electrodes = e;
+  resonator_.set_electrodes(e);
+}
+void SimTarget::set_effects(const Effects& fx) {
+  config_.effects = fx;
+  resonator_.set_effects(fx);
+}
+
+void SimTarget::set_adc_stuck(std::size_t channel, bool stuck) { adc_stuck_.at(channel) = stuck; }
+void SimTarget::set_adc_saturated(std::size_t channel, bool saturated) {
+  adc_saturated_.at(channel) = saturated;
+}
+void SimTarget::set_dac_dead(std::size_t channel, bool dead) { dac_dead_.at(channel) = dead; }
+void SimTarget::noise_burst(double rms_v, double duration_s) {
+  burst_rms_v_ = rms_v;
+  burst_left_s_ = duration_s;
+}
+
+double SimTarget::time_s() const {
+  return static_cast<double>(sample_index_) / config_.adc.sample_rate_hz;
+}
+
+uint64_t SimTarget::sample_time_ns(uint64_t index) const {
+  // Exact when the rate divides 1e9 (100 kHz: 10 us); otherwise rounded.
+  const uint64_t fs = config_.adc.sample_rate_hz;
+  return index / fs * 1'000'000'000ull + (index % fs) * 1'000'000'000ull / fs;
+}
+
+TrueState SimTarget::true_state() const {
+  TrueState s;
+  s.t_s = time_s();
+  cplx x;
+  cplx y;
+  resonator_.envelopes(x, y);
+  const WaveState w = wave_state(x, y);
+  s.pattern_angle_rad = pattern_angle_rad_ + std::remainder(w.theta_rad - last_theta_rad_, kPi / 2);
+  s.input_angle_rad = input_angle_rad_;
+  s.energy_v2 = w.energy_v2;
+  s.a_a_v = w.a_a_v;
+  s.a_b_v = w.a_b_v;
+  s.rate_rad_s = resonator_.rate_rad_s();
+  s.temp_c = resonator_.temperature_c();
+  s.excitation_enabled = excitation_.value;
+  s.pump_v = last_pump_v_;
+  return s;
+}
+
+Drive SimTarget::next_drive() {
+  // Double buffer: a frame the firmware queued, or zero when none is waiting.
+  DacFrame frame{};
+  if (dac_head_ < dac_queue_.size()) {
+    frame = dac_queue_[dac_head_++];
+    if (dac_head_ == dac_queue_.size()) {
+      dac_queue_.clear();
+      dac_head_ = 0;
+    }
+  } else if (dac_written_) {
+    ++counters_.dac_underruns;
+  }
+  if (!dac_latency_.empty()) {
+    std::swap(frame, dac_latency_[latency_pos_]);
+    latency_pos_ = (latency_pos_ + 1) % dac_latency_.size();
+  }
+  std::array<double, hal::kDacChannels> v{};
+  for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
+    bool saturated = false;
+    v[ch] = dac_q_.convert(frame[ch], saturated);
+    if (saturated) ++counters_.dac_saturated;
+    if (dac_dead_[ch] || !excitation_.value) v[ch] = 0.0;
+  }
+  return Drive{v[0], v[1], v[2]};
+}
+
+Status SimTarget::produce_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+                                uint32_t& clipped) {
+  const uint32_t n = config_.adc.block_frames;
+  if (frames.size() != static_cast<std::size_t>(n) * hal::kAdcChannels) {
+    return Status::invalid_argument;
+  }
+  const double dt = 1.0 / config_.adc.sample_rate_hz;
+  const double t0 = time_s();
+  t_first_ns = sample_time_ns(sample_index_);
+  clipped = 0;
+  for (uint32_t k = 0; k < n; ++k) {
+    const PickoffOutput p = resonator_.measured();
+    const double burst = burst_left_s_ > 0.0 ? burst_rms_v_ : 0.0;
+    const std::array<double, 2> volts{p.x_v, p.y_v};
+    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch) {
+      double v = volts[ch] + config_.adc.offset_v[ch];
+      const double rms = std::hypot(config_.adc.noise_v_rms[ch], burst);
+      if (rms > 0.0) v += rms * noise_.normal();
+      bool clip = false;
+      hal::sample_q31 word = adc_q_.convert(v, clip);
+      if (adc_saturated_[ch]) {
+        word = adc_q_.convert(1e300, clip);
+      }
+      if (adc_stuck_[ch]) {
+        word = adc_last_[ch];
+        clip = false;
+      }
+      adc_last_[ch] = word;
+      if (clip) ++clipped;
+      frames[2 * k + ch] = word;
+    }
+    const Drive d = next_drive();
+    last_pump_v_ = d.pump_v;
+    resonator_.step(d, dt);
+    ++sample_index_;
+    if (burst_left_s_ > 0.0) burst_left_s_ -= dt;
+  }
+  // Input angle: Simpson's rule over the block; pattern angle unwrapped per block.
+  const double t1 = time_s();
+  const Profile& rate = config_.rate_rad_s;
+  input_angle_rad_ +=
+      (t1 - t0) / 6.0 * (rate.value(t0) + 4.0 * rate.value(0.5 * (t0 + t1)) + rate.value(t1));
+  cplx x;
+  cplx y;
+  resonator_.envelopes(x, y);
+  const double theta = wave_state(x, y).theta_rad;
+  pattern_angle_rad_ += std::remainder(theta - last_theta_rad_, kPi / 2);
+  last_theta_rad_ = theta;
+  can_.tick(t1 - t0);
+  counters_.adc_clipped += clipped;
+  ++counters_.blocks;
+  return Status::ok;
+}
+
+hal::ConverterInfo SimTarget::SimAdc::info() const {
+  const auto& c = t->config_.adc;
+  return {c.sample_rate_hz, c.block_frames, c.full_scale_v};
+}
+
+Status SimTarget::SimAdc::read_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+                                     uint32_t& clipped) {
+  return t->produce_block(frames, t_first_ns, clipped);
+}
+
+hal::ConverterInfo SimTarget::SimDac::info() const {
+  const auto& c = t->config_;
+  return {c.adc.sample_rate_hz, c.adc.block_frames, c.dac.full_scale_v};
+}
+
+Status SimTarget::SimDac::write_block(std::span<const hal::sample_q31> frames) {
+  const std::size_t n = t->config_.adc.block_frames;
+  if (frames.size() != n * hal::kDacChannels) return Status::invalid_argument;
+  if (t->dac_queue_.size() - t->dac_head_ >= 4 * n)
+    return Status::would_block;  // four blocks ahead at most
+  for (std::size_t k = 0; k < n; ++k) {
+    t->dac_queue_.push_back({frames[3 * k], frames[3 * k + 1], frames[3 * k + 2]});
+  }
+  t->dac_written_ = true;
+  return Status::ok;
+}
+
+uint64_t SimTarget::SimClock::now_ns() const { return t->sample_time_ns(t->sample_index_); }
+
+Status SimTarget::SimClock::sleep_until_ns(uint64_t t_ns) {
+  return t_ns < now_ns() ? Status::timeout : Status::ok;
+}
+
+SimTarget& target() {
+  static SimTarget instance;
+  return instance;
+}
+
+}  // namespace hrg::sim
+
+namespace hrg::hal {
+
+Board& board() { return sim::target().board(); }
+
+}  // namespace hrg::hal

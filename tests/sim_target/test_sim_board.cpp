@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: MIT
+// Simulated board: converters, lockstep timing, drive gating, faults, CAN, determinism.
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "hal/board.hpp"
+#include "sim_target/control.hpp"
+
+#include "support/cpputest.hpp"
+
+using namespace hrg;
+using namespace hrg::sim;
+
+namespace {
+
+std::vector<hal::sample_q31> read_one(hal::Board& b, uint64_t& t_ns, uint32_t& clipped) {
+  std::vector<hal::sample_q31> v(b.adc.info().block_frames * hal::kAdcChannels);
+  CHECK(b.adc.read_block(v, t_ns, clipped) == hal::Status::ok);
+  return v;
+}
+
+void write_constant(hal::Board& b, const DacQuantizer& q, double pump_v, double fx_v) {
+  std::vector<hal::sample_q31> v(b.dac.info().block_frames * hal::kDacChannels);
+  for (std::size_t k = 0; k < v.size(); k += 3) {
+    v[k] = q.word_for(pump_v);
+    v[k + 1] = q.word_for(fx_v);
+  }
+  CHECK(b.dac.write_block(v) == hal::Status::ok);
+}
+
+}  // namespace
+
+TEST_GROUP(Converters){};
+
+TEST(Converters, AdcRoundsToTheLsbAndLeftJustifies) {
+  AdcConfig c;
+  c.bits = 16;
+  c.full_scale_v = 2.0;
+  AdcQuantizer q(c);
+  DOUBLES_EQUAL(2.0 / 32768.0, q.lsb_v(), 1e-15);
+  bool clip = true;
+  CHECK_EQUAL(3 * 65536, q.convert(3.2 * q.lsb_v(), clip));
+  CHECK_FALSE(clip);
+  CHECK_EQUAL(-3 * 65536, q.convert(-2.8 * q.lsb_v(), clip));
+}
+
+TEST(Converters, AdcClipsAtBothRailsAndReportsIt) {
+  AdcConfig c;
+  c.bits = 16;
+  c.full_scale_v = 2.0;
+  AdcQuantizer q(c);
+  bool clip = false;
+  CHECK_EQUAL(32767 * 65536, q.convert(2.5, clip));
+  CHECK(clip);
+  CHECK_EQUAL(INT32_MIN, q.convert(-7.0, clip));
+  CHECK(clip);
+  q.convert(1.99, clip);
+  CHECK_FALSE(clip);
+}
+
+TEST(Converters, DacTruncatesToItsBitsAndFlagsTheRails) {
+  DacConfig c;
+  c.bits = 12;
+  c.full_scale_v = 10.0;
+  DacQuantizer q(c);
+  bool sat = true;
+  DOUBLES_EQUAL(10.0 * 1000.0 / 2048.0, q.convert(1000 << 20 | 0xFFFFF, sat), 1e-12);
+  CHECK_FALSE(sat);
+  q.convert(INT32_MAX, sat);
+  CHECK(sat);
+  q.convert(INT32_MIN, sat);
+  CHECK(sat);
+  DOUBLES_EQUAL(2.5, q.convert(q.word_for(2.5), sat), 10.0 / 2048.0);
+}
+
+TEST_GROUP(SimBoard){// The board is a process-wide singleton (hal::board()): reconfiguring it
+                     // releases what a test made it allocate.
+                     void setup() override{target().configure(SimConfig{});
+}
+void teardown() override { target().configure(SimConfig{}); }
+}
+;
+
+TEST(SimBoard, ClockAdvancesOnlyWhenTheAdcProducesABlock) {
+  hal::Board& b = hal::board();
+  CHECK_EQUAL(0u, b.clock.now_ns());
+  CHECK(b.clock.sleep_until_ns(5'000'000) == hal::Status::ok);
+  CHECK_EQUAL(0u, b.clock.now_ns());
+  uint64_t t_ns = 99;
+  uint32_t clipped = 0;
+  read_one(b, t_ns, clipped);
+  CHECK_EQUAL(0u, t_ns);
+  CHECK_EQUAL(1'000'000u, b.clock.now_ns());  // 100 frames at 100 kHz
+  read_one(b, t_ns, clipped);
+  CHECK_EQUAL(1'000'000u, t_ns);
+  CHECK(b.clock.sleep_until_ns(1'500'000) == hal::Status::timeout);
+}
+
+TEST(SimBoard, DriveIsOutputOneBlockLaterPlusLatencyAndGatedByExcitationEnable) {
+  SimConfig c;
+  c.dac.latency_samples = 150;
+  target().configure(c);
+  hal::Board& b = hal::board();
+  DacQuantizer q(c.dac);
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  CHECK(b.excitation_enable.write(true) == hal::Status::ok);
+  read_one(b, t_ns, clipped);
+  write_constant(b, q, 4.0, 0.0);
+  write_constant(b, q, 4.0, 0.0);
+  read_one(b, t_ns, clipped);  // frames 0..99 of the queued drive are still in the latency line
+  DOUBLES_EQUAL(0.0, target().true_state().pump_v, 0.0);
+  read_one(b, t_ns, clipped);  // frame 50 onwards of this block carries the drive
+  DOUBLES_EQUAL(4.0, target().true_state().pump_v, 10.0 / 32768.0);
+  b.excitation_enable.write(false);
+  write_constant(b, q, 4.0, 0.0);
+  read_one(b, t_ns, clipped);
+  DOUBLES_EQUAL(0.0, target().true_state().pump_v, 0.0);
+}
+
+TEST(SimBoard, ForcerRingsTheResonatorUpAtTheForcerGain) {
+  // GIVEN a resonator at rest and a forcer along x at resonance, in phase with the velocity
+  SimConfig c;
+  c.resonator.dmu = 0.0;
+  c.resonator.split_hz = 0.0;
+  target().configure(c);
+  hal::Board& b = hal::board();
+  DacQuantizer q(c.dac);
+  b.excitation_enable.write(true);
+  const double w = c.resonator.omega_rad_s();
+  const double h = 1e-5;
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  std::vector<hal::sample_q31> block(300);
+  read_one(b, t_ns, clipped);
+  // WHEN 1 V forcer is applied for 1 s (100 blocks written one ahead)
+  for (int k = 0; k < 1000; ++k) {
+    for (int n = 0; n < 100; ++n) {
+      const double t_mid = ((k + 1) * 100 + n + 0.5) * h;  // block k+1 is output next
+      block[3 * n] = 0;
+      block[3 * n + 1] = q.word_for(-std::sin(w * t_mid));
+      block[3 * n + 2] = 0;
+    }
+    b.dac.write_block(block);
+    read_one(b, t_ns, clipped);
+  }
+  // THEN the amplitude follows a' = g V / (2w) - nu a (ZOH gain sinc(w h / 2))
+  const double nu = c.resonator.nu_per_s();
+  const double drive =
+      c.electrodes.forcer_gain_per_s2 / (2.0 * w) * std::sin(0.5 * w * h) / (0.5 * w * h);
+  const double t_on = 1.0;
+  const double expected = drive / nu * (1.0 - std::exp(-nu * t_on));
+  DOUBLES_EQUAL(expected, target().true_state().a_a_v, 2e-3 * expected);
+}
+
+TEST(SimBoard, SameSeedGivesTheSameBitsAndAnotherSeedDoesNot) {
+  SimConfig c;
+  c.adc.noise_v_rms = {1e-4, 2e-4};
+  c.initial.amplitude_v = 1.0;
+  c.seed = 42;
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  target().configure(c);
+  const auto a = read_one(hal::board(), t_ns, clipped);
+  target().configure(c);
+  const auto b = read_one(hal::board(), t_ns, clipped);
+  c.seed = 43;
+  target().configure(c);
+  const auto d = read_one(hal::board(), t_ns, clipped);
+  CHECK(a == b);
+  CHECK(a != d);
+}
+
+TEST(SimBoard, AdcNoiseHasTheConfiguredRms) {
+  SimConfig c;
+  c.adc.noise_v_rms = {1e-3, 3e-3};
+  target().configure(c);
+  AdcQuantizer q(c.adc);
+  std::array<double, 2> sum2{};
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  const int blocks = 200;
+  for (int k = 0; k < blocks; ++k) {
+    const auto v = read_one(hal::board(), t_ns, clipped);
+    for (std::size_t i = 0; i < v.size(); ++i)
+      sum2[i % 2] += std::pow(q.to_volts(v[i]), 2);
+  }
+  const double n = blocks * 100.0;
+  DOUBLES_EQUAL(1e-3, std::sqrt(sum2[0] / n), 0.03e-3);  // 3 % ~ 4 sigma of the estimate
+  DOUBLES_EQUAL(3e-3, std::sqrt(sum2[1] / n), 0.09e-3);
+}
+
+TEST(SimBoard, FaultsStickSaturateAndKillChannels) {
+  SimConfig c;
+  c.initial.amplitude_v = 1.0;
+  target().configure(c);
+  hal::Board& b = hal::board();
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  target().set_adc_stuck(0, true);
+  auto v = read_one(b, t_ns, clipped);
+  for (std::size_t i = 2; i < v.size(); i += 2)
+    CHECK_EQUAL(v[0], v[i]);
+  target().set_adc_stuck(0, false);
+  target().set_adc_saturated(1, true);
+  v = read_one(b, t_ns, clipped);
+  CHECK_EQUAL(100u, clipped);
+  CHECK_EQUAL(100u, target().counters().adc_clipped);
+  target().set_adc_saturated(1, false);
+  DacQuantizer q(c.dac);
+  b.excitation_enable.write(true);
+  target().set_dac_dead(0, true);
+  write_constant(b, q, 5.0, 0.0);
+  read_one(b, t_ns, clipped);
+  DOUBLES_EQUAL(0.0, target().true_state().pump_v, 0.0);
+  bool fault = true;
+  b.fault_input.read(fault);
+  CHECK_FALSE(fault);
+  target().set_fault_input(true);
+  b.fault_input.read(fault);
+  CHECK(fault);
+}
+
+TEST(SimBoard, InputAngleIntegratesTheRateProfile) {
+  SimConfig c;
+  c.rate_rad_s = Profile::sine(1.0, 2.0, 0.0);
+  target().configure(c);
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  for (int k = 0; k < 300; ++k)
+    read_one(hal::board(), t_ns, clipped);
+  const double t = 0.3;
+  const double expected = (1.0 - std::cos(2.0 * kPi * 2.0 * t)) / (2.0 * kPi * 2.0);
+  DOUBLES_EQUAL(expected, target().true_state().input_angle_rad, 1e-10);
+}
+
+TEST_GROUP(SimCan) { SimCan can; };
+
+TEST(SimCan, QueueFillsDrainsAtTheBusRateAndGoesBusOff) {
+  CanConfig c;
+  c.tx_queue_frames = 4;
+  c.tx_frames_per_ms = 2;
+  can.configure(c);
+  hal::CanFrame f;
+  f.id = 0x123;
+  f.len = 2;
+  for (int i = 0; i < 4; ++i)
+    CHECK(can.send(f) == hal::Status::ok);
+  CHECK(can.send(f) == hal::Status::would_block);
+  CHECK_EQUAL(1u, can.counters().tx_queue_full);
+  can.tick(1e-3);
+  CHECK_EQUAL(2u, can.sent().size());
+  can.force_bus_off();
+  CHECK(can.send(f) == hal::Status::bus_off);
+  CHECK(can.state() == hal::CanState::bus_off);
+  CHECK(can.restart() == hal::Status::ok);
+  CHECK_EQUAL(1u, can.counters().restarts);
+  CHECK(can.send(f) == hal::Status::ok);
+}
+
+TEST(SimCan, ReceiveFiltersInjectedFrames) {
+  const hal::CanFilter filt{0x100, 0x700};
+  can.set_filters(std::span<const hal::CanFilter>(&filt, 1));
+  hal::CanFrame f;
+  f.id = 0x123;
+  can.inject_rx(f);
+  f.id = 0x223;
+  can.inject_rx(f);
+  hal::CanFrame got;
+  CHECK(can.receive(got) == hal::Status::ok);
+  CHECK_EQUAL(0x123u, got.id);
+  CHECK(can.receive(got) == hal::Status::would_block);
+}
