@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Drift of the pattern angle and its compensation (docs/physics.md section 3,
+// the paper's eqs. 6, 7, 14, 22, 23, 29).
+//
+//   Omega K = -2 theta_A' + D,   D = D_nu + D_w + D_Phi   (all rad/s, "Omega K" units)
+//
+// Resonator part, eq. 6 divided by a_A^2 - a_B^2 (q = a_B/a_A):
+//   D_nu + D_w = [nu dmu sin4(th - th_mu) (1 + q^2) - 2 q dw cos4(th - th_w)] / (1 - q^2)
+//   nu dmu sin4(th - th_mu) = dnu_C sin4th - dnu_S cos4th
+//   dw cos4(th - th_w)      = dw_C cos4th + dw_S sin4th          (eq. 14)
+// To first order in q this is eq. 7. The paper's eq. 22 writes the split part
+// as -2q (dw_C sin4th + dw_S cos4th), which disagrees with its own eqs. 7 and
+// 14; the averaged model (sim_target) agrees with eq. 14 and with the exact
+// factors above to 1e-5 (tests/estimator/test_monte_carlo.cpp measures it).
+//
+// Control-loop part, eq. 23:
+//   D_Phi = -(a_PhiB/a_A) cos dphi_B + q (a_PhiA/a_A) cos dphi_A
+//
+// The gyro's input angle is -2 (theta_A - theta_A0)/K + integral of D/K dt; the
+// compensator integrates the modelled D/K, so a new estimate changes only the
+// rate from then on and the output never jumps.
+
+#include <estimator/types.hpp>
+
+namespace hrg::est {
+
+// D_nu + D_w (eq. 6 form above) for parameters p at pattern angle theta_A_rad with the
+// measured a_B/a_A. rad/s in Omega K units. Any context.
+double resonator_drift_rad_s(const ParamVector& p, double theta_A_rad, double aB_over_aA);
+
+// Integrates the modelled drift into an angle correction (input-axis radians).
+// Context: control-rate task. No heap.
+class DriftCompensator {
+ public:
+  // angular_gain: K (twice the Bryan factor), > 0.
+  explicit DriftCompensator(double angular_gain) : k_(angular_gain) {}
+
+  // Model used from the next step on. Before the first call the correction
+  // rate is zero.
+  void set_model(const ParamVector& p) {
+    p_ = p;
+    have_model_ = true;
+  }
+  // Advances by dt_s with the present pattern angle, a_B/a_A and the control
+  // loop drift estimate d_phi_rad_s (0 during free decay or if not estimated).
+  // Trapezoid rule on the rate; returns the correction to add to the raw angle.
+  double step(double theta_A_rad, double aB_over_aA, double d_phi_rad_s, double dt_s);
+  double correction_rad() const { return correction_rad_; }
+  // Last modelled input-rate correction D/K, rad/s.
+  double rate_rad_s() const { return rate_rad_s_; }
+  bool has_model() const { return have_model_; }
+  const ParamVector& model() const { return p_; }
+  void reset_angle() { correction_rad_ = 0; }
+
+ private:
+  double k_;
+  ParamVector p_ = ParamVector::Zero();
+  bool have_model_{false};
+  bool have_rate_{false};
+  double rate_rad_s_{0};
+  double correction_rad_{0};
+};
+
+// Control-loop drift D_Phi (sections 6-7) with the excitation on. With the
+// resonator identified, the left sides of eq. 3 (in the split form of eq. 20)
+//   f_A = a_A' + (nu + dnu(th)) a_A + g(th) a_B     = a_PhiA sin dphi_A
+//   f_B = a_B' + (nu - dnu(th)) a_B - g(th) a_A     = a_PhiB sin dphi_B
+// (dnu(th) = dnu_C cos4th + dnu_S sin4th, g(th) = dw_C sin4th - dw_S cos4th)
+// give the in-phase parts of the drives. Their out-of-phase parts follow from
+// the measured pump phase error eps = pi/2 - dphi_A (phase of the pump's
+// force against the wave's, minus the ideal pi/2): a_Phi cos dphi = f tan eps.
+// A quadrature forcer whose force the firmware commands is given separately
+// (its in-phase and out-of-phase parts); the rest of f_B is the pump's share,
+// which has the pump's phase error. Then eq. 23:
+//   D_Phi = -(fB_cos)/a_A + q fA_cos / a_A.
+// Derivatives come from block means over `block_s` (differences, never per
+// sample), the estimate is low-passed with time constant `smoothing_s`.
+class ControlDriftEstimator {
+ public:
+  struct Config {
+    double block_s = 0.1;      // block length for the derivative estimate
+    double smoothing_s = 5.0;  // first-order low-pass of D_Phi
+  };
+  struct Sample {
+    double t_s{0};
+    double a_A_v{0};
+    double a_B_v{0};
+    double theta_A_rad{0};
+    double pump_phase_error_rad{0};  // eps_A = pi/2 - (phi_PhiA - phi_A)
+    double quad_force_sin_v_s{0};    // quadrature forcer, part acting on a_B' (V/s)
+    double quad_force_cos_v_s{0};    // quadrature forcer, part acting on the angle (V/s)
+  };
+
+  ControlDriftEstimator() = default;
+  explicit ControlDriftEstimator(const Config& c) : config_(c) {}
+
+  void set_model(const ParamVector& p) { p_ = p; }
+  // Feeds one control-rate sample with the excitation on. Returns false (and
+  // restarts) on a time step <= 0 or a non-finite or non-positive a_A.
+  bool add_sample(const Sample& s);
+  // Restart after a free-decay window (the loops re-acquire).
+  void restart();
+  double d_phi_rad_s() const { return d_phi_rad_s_; }
+  bool valid() const { return have_estimate_; }
+
+ private:
+  struct Block {
+    double t{0}, aA{0}, aB{0}, c4{0}, s4{0}, tan_eps{0}, qs{0}, qc{0};
+    int n{0};
+  };
+  Config config_{};
+  ParamVector p_ = ParamVector::Zero();
+  Block acc_{};
+  Block prev_{};
+  bool have_prev_{false};
+  bool have_estimate_{false};
+  double t_block_start_s_{0};
+  double t_last_s_{0};
+  bool started_{false};
+  double d_phi_rad_s_{0};
+};
+
+}  // namespace hrg::est

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The estimator as the firmware's cyclic executive calls it.
+//
+//   free_decay entered:     begin_window(t_switch_s)
+//   each 1 kHz tick in it:  add_sample({t_s, a_A, a_B, theta_A, E})
+//   free_decay left:        end_window()           -> window folded into the LS
+//   at a slow rate (e.g. after each window):  solve_and_accept()
+//   each 1 kHz tick:        step_output(theta_A, a_B/a_A, dt, excitation_on)
+//                           -> angle correction (input-axis rad) to add to
+//                              -2 (theta_A - theta_A0) / K
+//   with excitation on:     add_control_sample(...) feeds the D_Phi estimate
+//   window scheduler:       conditioning(), coverage_s(), least_covered_theta_rad()
+//
+// Units: seconds, radians, amplitudes in any consistent unit (volts), rates
+// in rad/s. drift_rate_rad_s is D of eq. 7 ("Omega K" units); divide by K for
+// input rate. No heap, no exceptions; every call is bounded (see the bench).
+
+#include <estimator/drift.hpp>
+#include <estimator/normal_equations.hpp>
+#include <estimator/window_accumulator.hpp>
+
+namespace hrg::est {
+
+class Estimator {
+ public:
+  struct Config {
+    double angular_gain = 0.554;  // K
+    Variant variant = Variant::joint;
+    WindowAccumulator::Config window{};
+    NormalEquations::Config ls{};
+    ControlDriftEstimator::Config control{};
+    bool compensate_control_drift = true;
+  };
+
+  explicit Estimator(const Config& c)
+      : config_(c), window_(c.window), ls_(c.ls), comp_(c.angular_gain), control_(c.control) {}
+
+  Status begin_window(double t_switch_s) { return window_.begin_window(t_switch_s); }
+  Status add_sample(const WaveSample& s) { return window_.add_sample(s); }
+  // Folds the window into the normal equations; Status::too_short etc. drop it.
+  Status end_window();
+  // Solves the configured variant; the model used for compensation changes
+  // only if the solution is accepted (conditioning below the threshold).
+  Solution solve_and_accept();
+
+  // D_nu + D_w (eqs. 6/7/22, drift.hpp) with the accepted model, rad/s ("Omega K" units).
+  double drift_rate_rad_s(double theta_A_rad, double aB_over_aA) const {
+    return comp_.has_model() ? resonator_drift_rad_s(comp_.model(), theta_A_rad, aB_over_aA) : 0.0;
+  }
+  // Control-rate output correction; D_Phi is added only with excitation on.
+  double step_output(double theta_A_rad, double aB_over_aA, double dt_s, bool excitation_on);
+  bool add_control_sample(const ControlDriftEstimator::Sample& s) { return control_.add_sample(s); }
+
+  bool has_model() const { return comp_.has_model(); }
+  const ParamVector& model() const { return comp_.model(); }
+  const Solution& last_solution() const { return last_; }
+  double correction_rad() const { return comp_.correction_rad(); }
+  double d_phi_rad_s() const { return control_.valid() ? control_.d_phi_rad_s() : 0.0; }
+  Conditioning conditioning() const { return ls_.conditioning(); }
+  const CoverageHistogram& coverage_s() const { return ls_.coverage_s(); }
+  // Pattern angle (centre of the least covered 4theta bin, in [0, pi/2)).
+  double least_covered_theta_rad() const;
+  ParamMatrix cramer_rao_bound(double sigma_v) const { return ls_.cramer_rao_bound(sigma_v); }
+  const NormalEquations& normal_equations() const { return ls_; }
+  const WindowAccumulator& window() const { return window_; }
+
+ private:
+  Config config_;
+  WindowAccumulator window_;
+  NormalEquations ls_;
+  DriftCompensator comp_;
+  ControlDriftEstimator control_;
+  WindowContribution scratch_{};
+  Solution last_{};
+};
+
+}  // namespace hrg::est

@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+#include <estimator/estimator.hpp>
+
+#include <numbers>
+
+namespace hrg::est {
+
+Status Estimator::end_window() {
+  const Status s = window_.end_window(scratch_);
+  if (s == Status::ok) ls_.add_window(scratch_);
+  // The loops re-acquire after the window: the D_Phi derivatives restart.
+  control_.restart();
+  return s;
+}
+
+Solution Estimator::solve_and_accept() {
+  last_ = ls_.solve(config_.variant);
+  if (last_.accepted()) {
+    comp_.set_model(last_.p);
+    control_.set_model(last_.p);
+  }
+  return last_;
+}
+
+double Estimator::step_output(double theta_A_rad, double aB_over_aA, double dt_s,
+                              bool excitation_on) {
+  const double d_phi = excitation_on && config_.compensate_control_drift ? d_phi_rad_s() : 0.0;
+  return comp_.step(theta_A_rad, aB_over_aA, d_phi, dt_s);
+}
+
+double Estimator::least_covered_theta_rad() const {
+  // Bin i covers 4theta in [i, i+1) * 2pi/bins; its centre in theta is a quarter.
+  const double four_theta =
+      (ls_.least_covered_bin() + 0.5) * 2.0 * std::numbers::pi / kCoverageBins;
+  return 0.25 * four_theta;
+}
+
+}  // namespace hrg::est
