@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "firmware/gyro.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace hrg::fw {
@@ -204,8 +205,64 @@ void Gyro::task_solve(Gyro& g) {
 }
 
 void Gyro::task_telemetry(Gyro& g) {
-  // The CAN telemetry encoder is fed from status(); see firmware/can.
-  (void)g;
+  const GyroStatus& st = g.status_;
+  can::TelemetrySnapshot& s = g.snapshot_;
+  s.cx_v = st.chain.cx_v;
+  s.sx_v = st.chain.sx_v;
+  s.cy_v = st.chain.cy_v;
+  s.sy_v = st.chain.sy_v;
+  s.theta_a_rad = st.theta_unwrapped_rad;
+  s.output_angle_rad = st.out_angle_rad;
+  s.pll_freq_hz = st.chain.f_ref_hz;
+  s.pll_locked = st.chain.locked;
+  s.quad_effort = st.chain.quad_effort;
+  s.pump_v = st.chain.pump_v;
+  s.agc_setpoint_v = g.cfg_.amplitude_set_v;
+  s.mode = st.mode;
+  s.exc_on = st.excitation_on;
+  s.exc_line = st.enable_line;
+  s.fault_input = st.fault_input;
+  s.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
+  s.faults = static_cast<uint16_t>(st.faults | g.mode_.faults());
+  const Identification id = g.identifier_.identification();
+  s.nu_per_s = id.p[0];
+  s.dnu_c_per_s = id.p[1];
+  s.dnu_s_per_s = id.p[2];
+  s.dw_c_rad_s = id.p[3];
+  s.dw_s_rad_s = id.p[4];
+  const EstimatorHealth h = g.identifier_.health();
+  s.cond_log10 = h.condition > 0.0 ? std::log10(h.condition) : 0.0;
+  s.coverage = h.coverage;
+  s.windows = g.scheduler_.windows();
+  s.est_valid = id.valid;
+  uint32_t overruns = 0;
+  uint64_t busy_ns = 0;
+  for (const auto& t : g.exec_.task_stats()) {
+    overruns += t.overruns;
+    busy_ns += t.total_ns;
+  }
+  const FrameStats& f = g.exec_.frame_stats();
+  s.overruns = overruns;
+  s.missed_ticks = f.missed_frames;
+  s.max_frame_us = f.max_frame_ns / 1000;
+  s.cpu_load_pct =
+      f.frames == 0
+          ? 0.0
+          : 100.0 * static_cast<double>(busy_ns) /
+                (static_cast<double>(f.frames) * static_cast<double>(g.exec_.period_ns()));
+  s.angular_gain = g.cfg_.angular_gain;
+  s.window_period_s = static_cast<double>(g.cfg_.windows.period_frames) / kBaseRateHz;
+  s.window_length_s = static_cast<double>(g.cfg_.windows.length_frames) / kBaseRateHz;
+  s.can = g.board_.can.counters();
+  s.can_state = g.board_.can.state();
+
+  std::array<hal::CanFrame, can::kTelemetryCount> frames{};
+  const std::size_t n = g.telemetry_.tick(s, frames);
+  for (std::size_t i = 0; i < n; ++i) {
+    // A full queue drops the frame (counted by the driver and here); the
+    // executive never waits for the bus.
+    if (g.board_.can.send(frames[i]) != hal::Status::ok) ++g.can_refused_;
+  }
 }
 
 }  // namespace hrg::fw

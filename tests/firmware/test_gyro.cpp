@@ -233,3 +233,15 @@ TEST(Gyro, ABoardWithAnotherBlockLayoutIsRefusedWithDrivesOff) {
   CHECK(Mode::power_up == g.status().mode);
   CHECK_FALSE(b.enable.level());
 }
+
+TEST(Gyro, SendsTheCanTelemetryAtTheProtocolsDefaultRates) {
+  auto cfg = test_config();
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  run(g, 1000);  // one second
+  uint32_t per_second = 0;
+  for (const auto& m : hrg::fw::can::kTelemetry)
+    per_second += m.default_rate_hz;
+  LONGS_EQUAL(per_second, b.can.counters().tx_frames);
+  LONGS_EQUAL(0, g.can_tx_refused());
+  DOUBLES_EQUAL(cfg.angular_gain, g.telemetry().angular_gain, 0.0);
+}

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "firmware/angle_output.hpp"
+#include "firmware/can/telemetry.hpp"
 #include "firmware/executive.hpp"
 #include "firmware/fault_monitor.hpp"
 #include "firmware/mode.hpp"
@@ -82,6 +83,9 @@ class Gyro {
   const GyroConfig& config() const { return cfg_; }
   // False when the board's converters do not match the firmware's block layout.
   bool board_ok() const { return board_ok_; }
+  // CAN telemetry as last encoded (the snapshot the frames were made from).
+  const can::TelemetrySnapshot& telemetry() const { return snapshot_; }
+  uint32_t can_tx_refused() const { return can_refused_; }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);
@@ -106,6 +110,9 @@ class Gyro {
   ShutdownScheduler scheduler_;
   AngleOutput output_;
   GyroStatus status_{};
+  can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
+  can::TelemetrySnapshot snapshot_{};
+  uint32_t can_refused_ = 0;
   ChainCommands commands_{};
   std::array<hal::sample_q31, kBlockFrames * hal::kAdcChannels> adc_{};
   std::array<hal::sample_q31, kBlockFrames * hal::kDacChannels> dac_{};
@@ -133,7 +140,7 @@ inline constexpr std::array<Task<Gyro>, Gyro::kTaskCount> kGyroTasks{{
     {"identify", &Gyro::task_identify, kBaseRateHz, 40'000},
     {"output", &Gyro::task_output, kBaseRateHz, 20'000},
     {"solve", &Gyro::task_solve, 10, 200'000},
-    {"telemetry", &Gyro::task_telemetry, 100, 100'000},
+    {"telemetry", &Gyro::task_telemetry, kBaseRateHz, 60'000},
 }};
 static_assert(all_rates_divide(kGyroTasks, kBaseRateHz),
               "every task rate must divide the base rate");

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "estimator/estimator.hpp"
+#include "firmware/ports.hpp"
+
+namespace hrg::fw {
+
+// The firmware's Identifier over est::Estimator (seed section 5): window
+// samples go to the accumulator, solve() folds nothing new but re-solves and
+// accepts the model when the conditioning allows, the drift is eq. 22.
+class EstimatorPort final : public Identifier {
+ public:
+  explicit EstimatorPort(const est::Estimator::Config& cfg) : est_(cfg) {}
+
+  void begin_window(double t_s) override;
+  void add_sample(const ChainOutputs& s) override;
+  void end_window() override;
+  void abort_window() override;
+  void solve() override;
+  EstimatorHealth health() const override { return health_; }
+  Identification identification() const override;
+  double drift_rad_s(double theta_a_rad, double ab_over_aa) const override {
+    return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa);
+  }
+
+  const est::Estimator& estimator() const { return est_; }
+  uint32_t windows_accepted() const { return windows_ok_; }
+  uint32_t windows_rejected() const { return windows_bad_; }
+  uint32_t solves_accepted() const { return solves_ok_; }
+
+ private:
+  est::Estimator est_;
+  EstimatorHealth health_{};
+  bool dirty_ = false;  // a window was added since the last solve
+  uint32_t windows_ok_ = 0;
+  uint32_t windows_bad_ = 0;
+  uint32_t solves_ok_ = 0;
+};
+
+}  // namespace hrg::fw
