@@ -1,0 +1,32 @@
+# SPDX-License-Identifier: MIT
+# Instructions per frame (one sample of each channel) of the fast path,
+# counted by callgrind (deterministic). Goal: <= 60 for Q1.31 on x86-64.
+set(blocks 2000)
+set(frames_per_block 100)
+math(EXPR frames "${blocks} * ${frames_per_block}")
+set(q31_ir 0)
+foreach(type q31 f32 f64)
+  set(out_file ${WORK_DIR}/callgrind.fast_path.${type})
+  execute_process(COMMAND ${VALGRIND} --tool=callgrind --callgrind-out-file=${out_file}
+      --toggle-collect=hrg_bench_fast_path_${type} ${BENCH} ${type} ${blocks}
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "callgrind run of ${BENCH} ${type} failed (${rc})")
+  endif()
+  file(STRINGS ${out_file} totals REGEX "^(summary|totals):")
+  list(GET totals 0 line)
+  string(REGEX MATCH "[0-9]+" ir "${line}")
+  math(EXPR per_frame_x100 "${ir} * 100 / ${frames}")
+  math(EXPR whole "${per_frame_x100} / 100")
+  math(EXPR frac "${per_frame_x100} % 100")
+  if(frac LESS 10)
+    set(frac "0${frac}")
+  endif()
+  message("fast path ${type}: ${ir} instructions for ${frames} frames = ${whole}.${frac} per frame (x and y)")
+  if(type STREQUAL "q31")
+    set(q31_ir ${per_frame_x100})
+  endif()
+endforeach()
+if(q31_ir GREATER 6000)
+  message(WARNING "Q1.31 fast path above the goal of 60 instructions per frame")
+endif()
