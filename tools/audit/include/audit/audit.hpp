@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "recording/recording.hpp"
+
+// `hrg audit`: fits the seed's averaged resonator model (docs/physics.md) to a
+// recording by output error, then extends it with the effects of
+// docs/effects-catalog.md one at a time (forward selection, BIC at the
+// effective sample count, held-out segments) and reports what physics the
+// recording needs that the baseline leaves out. Host-only.
+namespace hrg::audit {
+
+enum class Effect {
+  pickoff_gain_mismatch,
+  pickoff_phase_mismatch,
+  pickoff_misalignment,
+  duffing_stiffness,
+  nonlinear_damping,
+  thermal_frequency,
+  thermal_damping,
+  electrostatic_spring,
+  drive_feedthrough,
+};
+inline constexpr int kEffectCount = 9;
+
+struct EffectInfo {
+  Effect effect;
+  const char* id;                     // catalogue id
+  const char* param;                  // catalogue parameter name
+  const char* unit;                   // catalogue unit
+  const char* explanation;            // one plain sentence of physics
+  const char* separating_experiment;  // what tells it from its confusable partners
+};
+const EffectInfo& effect_info(Effect e);
+const std::array<EffectInfo, kEffectCount>& effect_table();
+
+struct AuditOptions {
+  // Largest number of averaging blocks over all free-decay samples: bounds the
+  // cost for long recordings while the slow envelope keeps its information.
+  int max_blocks = 12000;
+  // Evidence needed to accept an effect (delta BIC at the effective sample count).
+  double min_delta_bic = 10.0;
+  // Two candidates whose delta BIC differ by less than this are not told apart.
+  double ambiguity_bic = 6.0;
+  // Residual variance over high-frequency noise variance above which the
+  // remaining structure is called unexplained.
+  double unexplained_ratio = 1.5;
+};
+
+struct Location {
+  std::string signal;
+  std::string where;
+  double score = 0.0;
+};
+
+struct Finding {
+  Effect effect;
+  double value = 0.0;  // catalogue parameter, catalogue unit
+  double sigma = 0.0;  // 1-sigma uncertainty, same unit
+  double delta_bic = 0.0;
+  double heldout_rms_before_v = 0.0;
+  double heldout_rms_after_v = 0.0;
+  std::string impact;  // in gyro units
+};
+
+struct Alternative {
+  Effect effect;
+  double value = 0.0;
+  double delta_bic = 0.0;
+  std::string note;
+};
+
+// Evidence for one candidate added to the baseline alone (first selection step).
+struct CandidateScore {
+  Effect effect;
+  bool testable = false;  // false when the recording lacks what it needs (e.g. temp_c)
+  double value = 0.0;
+  double sigma = 0.0;  // Cramer-Rao-like 1-sigma from the fit (effective samples)
+  double delta_bic = 0.0;
+  // Strength at which the expected delta BIC of this effect alone is zero
+  // (the detection threshold of this recording's design and noise).
+  double threshold = 0.0;
+};
+
+struct BaselineParams {
+  double f_hz = 0.0;
+  double nu_per_s = 0.0;
+  double dmu = 0.0;
+  double theta_mu_deg = 0.0;
+  double split_hz = 0.0;
+  double theta_w_deg = 0.0;
+  double angular_gain = 0.0;
+  double q = 0.0;
+};
+
+struct AuditResult {
+  std::string verdict;  // consistent | explained | ambiguous | unexplained
+  BaselineParams baseline;
+  double heldout_rms_v = 0.0;        // baseline, held-out free-decay segments
+  double heldout_rms_final_v = 0.0;  // selected model, same segments
+  double fit_rms_before_v = 0.0;     // baseline, all free-decay samples
+  double fit_rms_after_v = 0.0;      // selected model
+  double noise_v = 0.0;              // white-noise level from second differences
+  double n_effective = 0.0;
+  std::vector<Location> locations;
+  std::vector<Finding> findings;
+  std::vector<Alternative> alternatives;
+  std::vector<CandidateScore> candidates;
+  std::string ambiguity_experiment;
+  std::string unexplained_note;
+  std::vector<std::string> notes;  // gaps, skipped tests, ...
+  int free_segments = 0;
+  int forced_segments = 0;
+  int heldout_segments = 0;
+  int blocks = 0;
+  int samples_per_block = 1;
+};
+
+// Runs the audit. Throws std::runtime_error when the recording has too little
+// free decay to fit the baseline.
+struct PlotData;
+// `plot`, when given, receives the per-block series for write_plots().
+AuditResult run_audit(const recording::Recording& rec, const AuditOptions& opt = {},
+                      PlotData* plot = nullptr);
+
+// The JSON contract of issue 8 (plus a few extra keys).
+std::string to_json(const AuditResult& r);
+// The human report: verdict first.
+std::string to_text(const AuditResult& r, const std::string& source);
+
+}  // namespace hrg::audit

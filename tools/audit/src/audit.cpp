@@ -1,0 +1,439 @@
+// SPDX-License-Identifier: MIT
+#include "audit/audit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+
+#include "audit/plots.hpp"
+#include "dataset.hpp"
+#include "dsp/wave_variables.hpp"
+#include "fit.hpp"
+#include "model.hpp"
+#include "selection.hpp"
+
+namespace hrg::audit {
+
+namespace {
+
+using namespace detail;
+constexpr double kPi = std::numbers::pi;
+constexpr double kRadToDeg = 180.0 / kPi;
+
+// Model parameter of each effect (-1: the edge statistic instead).
+int param_of(Effect e) {
+  static constexpr int kMap[kEffectCount] = {kGain, kPhase, kMis, kDuff, kNld, kTf, kTd, kEs, -1};
+  return kMap[static_cast<int>(e)];
+}
+
+// Internal parameter -> catalogue unit.
+double to_catalogue(Effect e, double v) {
+  if (e == Effect::pickoff_phase_mismatch || e == Effect::pickoff_misalignment) {
+    return v * kRadToDeg;
+  }
+  return v;
+}
+
+struct State {
+  Mask mask{};
+  FitResult fit;
+  std::vector<double> res;
+  double kappa = 1.0;
+  bool feedthrough = false;
+};
+
+class Auditor {
+ public:
+  Auditor(const recording::Recording& rec, const AuditOptions& opt)
+      : opt_(opt), d_(build_dataset(rec, opt.max_blocks)) {}
+
+  AuditResult run(PlotData* plot);
+
+ private:
+  double n_free_res() const { return 4.0 * static_cast<double>(n_blocks_fit_); }
+  bool testable(Effect e) const;
+  State fit_state(const Mask& mask, const Params& start, bool feedthrough);
+  double ln_neff(const State& s) const {
+    return std::log(std::max(10.0, s.kappa * static_cast<double>(s.fit.n_res)));
+  }
+  double delta_bic(const State& cur, const State& next, int extra) const {
+    const double kappa = std::min(cur.kappa, next.kappa);
+    double dchi = kappa * (cur.fit.chi2 - next.fit.chi2);
+    return dchi - extra * ln_neff(next);
+  }
+  double heldout_rms(const Mask& mask, const Params& start);
+  std::string impact(Effect e, double v, const Params& p) const;
+  void fill_plot(const Params& before, const Params& after, PlotData& plot) const;
+
+  AuditOptions opt_;
+  Dataset d_;
+  EvalOptions eo_;
+  std::size_t n_blocks_fit_ = 0;
+};
+
+bool Auditor::testable(Effect e) const {
+  switch (e) {
+    case Effect::thermal_frequency:
+    case Effect::thermal_damping: return d_.has_temp && d_.temp_span_c > 0.02;
+    case Effect::electrostatic_spring:
+      return d_.has_pump && d_.forced.size() >= 3 && eo_.forced_sigma_rad_s > 0.0;
+    case Effect::drive_feedthrough: return d_.edges.size() >= 3;
+    default: return true;
+  }
+}
+
+State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough) {
+  State s;
+  s.mask = mask;
+  s.feedthrough = feedthrough;
+  s.fit = fit(d_, start, mask, eo_);
+  evaluate(d_, s.fit.p, eo_, s.res);
+  s.kappa = effective_fraction(s.res, static_cast<std::size_t>(n_free_res()));
+  return s;
+}
+
+double Auditor::heldout_rms(const Mask& mask, const Params& start) {
+  EvalOptions train = eo_;
+  train.include_heldout = false;
+  const FitResult f = fit(d_, start, mask, train);
+  EvalOptions ho;
+  ho.heldout_only = true;
+  std::vector<double> r;
+  evaluate(d_, f.p, ho, r);
+  if (r.empty()) return 0.0;
+  double s = 0.0;
+  for (double v : r)
+    s += v * v;
+  // Back from noise units to volts per block sample.
+  return std::sqrt(s / static_cast<double>(r.size())) * d_.noise_v;
+}
+
+std::string Auditor::impact(Effect e, double v, const Params& p) const {
+  char buf[256];
+  const double k = p[kK] > 0 ? p[kK] : d_.angular_gain;
+  double a2 = 0.0, v2 = 0.0;
+  for (const auto& f : d_.forced)
+    a2 += f.mean_a2, v2 += f.mean_v2;
+  if (!d_.forced.empty()) a2 /= static_cast<double>(d_.forced.size());
+  if (!d_.forced.empty()) v2 /= static_cast<double>(d_.forced.size());
+  if (d_.forced.empty() && !d_.blocks.empty()) a2 = d_.blocks.front().a2_v2;
+  const double dw = std::hypot(p[kDwC], p[kDwS]);
+  const double nu = p[kNu];
+  switch (e) {
+    case Effect::pickoff_gain_mismatch:
+      std::snprintf(buf, sizeof buf,
+                    "pattern-angle readout error up to %.3g deg physical (%.3g deg of gyro angle, "
+                    "4-theta pattern)",
+                    std::abs(v) / 4.0 * kRadToDeg, std::abs(v) / 2.0 / k * kRadToDeg);
+      break;
+    case Effect::pickoff_phase_mismatch:
+      std::snprintf(buf, sizeof buf,
+                    "false quadrature a_B/a_A up to %.3g; a quadrature loop nulling it adds an "
+                    "angle-dependent bias up to %.3g deg/h through the split",
+                    std::abs(v) / 2.0 / kRadToDeg,
+                    2.0 * dw * std::abs(v) / 2.0 / kRadToDeg / k * kRadToDeg * 3600.0);
+      break;
+    case Effect::pickoff_misalignment:
+      std::snprintf(buf, sizeof buf,
+                    "pattern-angle readout error up to %.3g deg physical (%.3g deg of gyro angle)",
+                    std::abs(v), 2.0 * std::abs(v) / k);
+      break;
+    case Effect::duffing_stiffness:
+      std::snprintf(buf, sizeof buf, "%.3g mHz frequency shift at the set-point amplitude",
+                    v * a2 * 1e3);
+      break;
+    case Effect::nonlinear_damping:
+      std::snprintf(buf, sizeof buf,
+                    "Q lower by %.3g %% at the set point; damping-anisotropy bias scales by "
+                    "the same factor (%.3g deg/h)",
+                    100.0 * v * a2 / (1.0 + v * a2),
+                    v * a2 * std::hypot(p[kDnuC], p[kDnuS]) / k * kRadToDeg * 3600.0);
+      break;
+    case Effect::thermal_frequency:
+      std::snprintf(buf, sizeof buf, "%.3g mHz per degC", v * 1e-6 * d_.f_ref_hz * 1e3);
+      break;
+    case Effect::thermal_damping:
+      std::snprintf(buf, sizeof buf,
+                    "Q changes %.3g %% per degC; damping-anisotropy bias %.3g deg/h per degC",
+                    -100.0 * v,
+                    std::abs(v) * std::hypot(p[kDnuC], p[kDnuS]) / k * kRadToDeg * 3600.0);
+      break;
+    case Effect::electrostatic_spring:
+      std::snprintf(buf, sizeof buf,
+                    "%.3g mHz frequency shift while the pump is on (mean pump_v^2 %.3g V^2)",
+                    v * v2 * 1e3, v2);
+      break;
+    case Effect::drive_feedthrough:
+      std::snprintf(
+          buf, sizeof buf,
+          "measured-signal offset %.3g V at the mean pump voltage: false angle/quadrature "
+          "up to %.3g deg while the excitation is on",
+          v * std::sqrt(v2), v * std::sqrt(v2) / std::sqrt(std::max(a2, 1e-30)) * kRadToDeg / 2.0);
+      break;
+  }
+  (void)nu;
+  return buf;
+}
+
+void Auditor::fill_plot(const Params& before, const Params& after, PlotData& plot) const {
+  std::vector<std::array<cplx, 2>> pb, pa;
+  std::vector<double> rb, ra;
+  EvalOptions all = eo_;
+  evaluate(d_, before, all, rb, &pb);
+  evaluate(d_, after, all, ra, &pa);
+  auto wave = [](cplx x, cplx y) {
+    return dsp::wave_variables<double>({x.real(), -x.imag(), y.real(), -y.imag()});
+  };
+  std::size_t k = 0;
+  for (std::size_t si = 0; si < d_.free.size(); ++si) {
+    const auto& s = d_.free[si];
+    for (std::size_t b = 0; b < s.n_blocks; ++b, k += 4) {
+      const auto i = s.first_block + b;
+      const Block& bl = d_.blocks[i];
+      const auto wm = wave(bl.x, bl.y), wb = wave(pb[i][0], pb[i][1]),
+                 wa = wave(pa[i][0], pa[i][1]);
+      plot.t_s.push_back(bl.t_s);
+      plot.segment.push_back(static_cast<int>(si));
+      plot.theta_deg.push_back(bl.theta_rad * kRadToDeg);
+      plot.a_meas.push_back(wm.a_A), plot.a_before.push_back(wb.a_A),
+          plot.a_after.push_back(wa.a_A);
+      plot.q_meas.push_back(wm.a_B), plot.q_before.push_back(wb.a_B),
+          plot.q_after.push_back(wa.a_B);
+      auto rms4 = [&](const std::vector<double>& r) {
+        return std::sqrt(
+            (r[k] * r[k] + r[k + 1] * r[k + 1] + r[k + 2] * r[k + 2] + r[k + 3] * r[k + 3]) / 4.0);
+      };
+      plot.res_before.push_back(rms4(rb));
+      plot.res_after.push_back(rms4(ra));
+    }
+  }
+}
+
+AuditResult Auditor::run(PlotData* plot) {
+  AuditResult out;
+  out.notes = d_.notes;
+  for (const auto& s : d_.free)
+    n_blocks_fit_ += s.n_blocks;
+  // Start values: decay rate from the energy of each free segment.
+  Params p0{};
+  {
+    double num = 0.0, den = 0.0;
+    for (const auto& s : d_.free) {
+      const Block& a = d_.blocks[s.first_block];
+      const Block& b = d_.blocks[s.first_block + s.n_blocks - 1];
+      const double ea = std::norm(a.x) + std::norm(a.y), eb = std::norm(b.x) + std::norm(b.y);
+      if (ea > 0 && eb > 0 && b.t_s > a.t_s) {
+        num += -0.5 * std::log(eb / ea);
+        den += b.t_s - a.t_s;
+      }
+    }
+    p0[kNu] = den > 0 ? std::max(num / den, 1e-6) : 1e-3;
+    p0[kK] = d_.angular_gain;
+  }
+  Mask base{};
+  for (int i : {kDw0, kNu, kDnuC, kDnuS, kDwC, kDwS})
+    base[static_cast<std::size_t>(i)] = true;
+  double precession = 0.0;
+  for (const auto& s : d_.free) {
+    precession += std::abs(d_.blocks[s.first_block].rate_rad_s) * (s.t1_s - s.t0_s);
+  }
+  if (precession * d_.angular_gain > 1.0) base[kK] = true;
+
+  // Baseline on the free decays alone, then the excitation-segment frequencies
+  // join with their scatter as weight.
+  State cur = fit_state(base, p0, false);
+  if (d_.forced.size() >= 3) {
+    auto fr = forced_residuals(d_, cur.fit.p);
+    std::vector<double> dev(fr);
+    std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(dev.size() / 2),
+                     dev.end());
+    const double med = dev[dev.size() / 2];
+    for (auto& v : dev)
+      v = std::abs(v - med);
+    std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(dev.size() / 2),
+                     dev.end());
+    double se = 0.0;
+    for (const auto& f : d_.forced)
+      se = std::max(se, f.se_rad_s);
+    eo_.forced_sigma_rad_s = std::max(1.4826 * dev[dev.size() / 2], se);
+    cur = fit_state(base, cur.fit.p, false);
+  }
+  const State baseline = cur;
+  out.noise_v = d_.noise_v;
+  out.free_segments = static_cast<int>(d_.free.size());
+  out.forced_segments = static_cast<int>(d_.forced.size());
+  out.blocks = static_cast<int>(d_.blocks.size());
+  out.samples_per_block = d_.samples_per_block;
+  for (const auto& s : d_.free)
+    out.heldout_segments += s.heldout ? 1 : 0;
+
+  // Forward selection.
+  std::vector<Effect> chosen;
+  std::vector<double> chosen_dbic;
+  FeedStat ft;
+  bool first_step = true;
+  while (chosen.size() < 4) {
+    struct Cand {
+      Effect e;
+      State s;
+      double dbic;
+      double value, sigma;
+    };
+    std::vector<Cand> cands;
+    for (const auto& info : effect_table()) {
+      const Effect e = info.effect;
+      if (std::find(chosen.begin(), chosen.end(), e) != chosen.end()) continue;
+      const bool ok = testable(e);
+      if (!ok) {
+        if (first_step) out.candidates.push_back({e, false, 0.0, 0.0, 0.0, 0.0});
+        continue;
+      }
+      if (e == Effect::drive_feedthrough) {
+        // Tested at the end, against the final free-decay model: edge jumps
+        // are only evidence once the decays themselves are fitted.
+        if (first_step) {
+          ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
+          out.candidates.push_back({e, true, std::max(ft.c_x, ft.c_y), ft.sigma,
+                                    ft.dchi2 - 4.0 * ln_neff(cur), ft.threshold});
+        }
+        continue;
+      }
+      Mask m = cur.mask;
+      const auto pi = static_cast<std::size_t>(param_of(e));
+      m[pi] = true;
+      State s = fit_state(m, cur.fit.p, cur.feedthrough);
+      const double dbic = delta_bic(cur, s, 1);
+      cands.push_back({e, s, dbic, to_catalogue(e, s.fit.p[pi]),
+                       to_catalogue(e, s.fit.sigma[pi]) / std::sqrt(s.kappa)});
+      if (first_step) {
+        const double sig = std::abs(to_catalogue(e, s.fit.sigma[pi])) / std::sqrt(s.kappa);
+        out.candidates.push_back(
+            {e, true, to_catalogue(e, s.fit.p[pi]), sig, dbic, sig * std::sqrt(ln_neff(s))});
+      }
+    }
+    first_step = false;
+    std::sort(cands.begin(), cands.end(),
+              [](const Cand& a, const Cand& b) { return a.dbic > b.dbic; });
+    if (cands.empty() || cands[0].dbic < opt_.min_delta_bic) {
+      for (const auto& c : cands) {
+        if (c.dbic > 0.0) {
+          out.alternatives.push_back(
+              {c.e, c.value, c.dbic, "some evidence, below the acceptance level"});
+        }
+      }
+      break;
+    }
+    const Cand& win = cands[0];
+    // Runner-up close to the winner: re-test it given the winner.
+    if (cands.size() > 1 && cands[1].dbic > opt_.min_delta_bic &&
+        win.dbic - cands[1].dbic < opt_.ambiguity_bic) {
+      const Cand& ru = cands[1];
+      bool both = false;
+      {
+        Mask m = win.s.mask;
+        m[static_cast<std::size_t>(param_of(ru.e))] = true;
+        const State s2 = fit_state(m, win.s.fit.p, false);
+        both = delta_bic(win.s, s2, 1) > opt_.min_delta_bic;
+      }
+      if (!both) {
+        out.alternatives.push_back({ru.e, ru.value, ru.dbic,
+                                    "explains the same mismatch almost as well; not needed once "
+                                    "the first is in"});
+        out.ambiguity_experiment = std::string(effect_info(win.e).id) + " vs " +
+                                   effect_info(ru.e).id + ": " +
+                                   effect_info(win.e).separating_experiment;
+      }
+    }
+    chosen.push_back(win.e);
+    chosen_dbic.push_back(win.dbic);
+    cur = win.s;
+  }
+
+  // Drive feedthrough against the final model.
+  ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
+  if (testable(Effect::drive_feedthrough)) {
+    const double dbic = ft.dchi2 - 4.0 * ln_neff(cur);
+    if (dbic >= opt_.min_delta_bic) {
+      chosen.push_back(Effect::drive_feedthrough);
+      chosen_dbic.push_back(dbic);
+    } else if (dbic > 0.0) {
+      out.alternatives.push_back({Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic,
+                                  "some evidence, below the acceptance level"});
+    }
+  }
+
+  // Final numbers.
+  out.baseline.angular_gain = baseline.fit.p[kK];
+  const Params& pb = baseline.fit.p;
+  out.baseline.f_hz = d_.f_ref_hz + (d_.carrier_rad_s + pb[kDw0]) / (2.0 * kPi);
+  out.baseline.nu_per_s = pb[kNu];
+  out.baseline.dmu = std::hypot(pb[kDnuC], pb[kDnuS]) / pb[kNu];
+  out.baseline.theta_mu_deg = std::atan2(pb[kDnuS], pb[kDnuC]) / 4.0 * kRadToDeg;
+  out.baseline.split_hz = std::hypot(pb[kDwC], pb[kDwS]) / kPi;
+  out.baseline.theta_w_deg = std::atan2(pb[kDwS], pb[kDwC]) / 4.0 * kRadToDeg;
+  out.baseline.q = kPi * out.baseline.f_hz / pb[kNu];
+  out.n_effective = cur.kappa * static_cast<double>(cur.fit.n_res);
+  auto rms_v = [&](const State& s) {
+    double acc = 0.0;
+    const auto n = static_cast<std::size_t>(n_free_res());
+    for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
+      acc += s.res[i] * s.res[i];
+    return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
+  };
+  out.fit_rms_before_v = rms_v(baseline);
+  out.fit_rms_after_v = rms_v(cur);
+  out.heldout_rms_v = heldout_rms(baseline.mask, baseline.fit.p);
+  out.heldout_rms_final_v = chosen.empty() ? out.heldout_rms_v : heldout_rms(cur.mask, cur.fit.p);
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    Finding f;
+    f.effect = chosen[i];
+    f.delta_bic = chosen_dbic[i];
+    if (chosen[i] == Effect::drive_feedthrough) {
+      ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
+      f.value = std::max(ft.c_x, ft.c_y);
+      f.sigma = ft.sigma;
+    } else {
+      const auto pi = static_cast<std::size_t>(param_of(chosen[i]));
+      f.value = to_catalogue(chosen[i], cur.fit.p[pi]);
+      f.sigma = to_catalogue(chosen[i], cur.fit.sigma[pi]) / std::sqrt(cur.kappa);
+    }
+    f.heldout_rms_before_v = out.heldout_rms_v;
+    f.heldout_rms_after_v = out.heldout_rms_final_v;
+    f.impact = impact(chosen[i], f.value, cur.fit.p);
+    out.findings.push_back(f);
+  }
+  out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.forced_sigma_rad_s, ft);
+
+  // Structure left after the selected model.
+  const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  if (ratio > opt_.unexplained_ratio) {
+    const auto left = locate(d_, cur.fit.p, cur.res, eo_.forced_sigma_rad_s,
+                             feedthrough_stat(d_, cur.fit.p, ln_neff(cur)));
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "residual variance %.2f x the white-noise level after the best model", ratio);
+    out.unexplained_note = buf;
+    if (!left.empty())
+      out.unexplained_note += "; largest at " + left.front().signal + ", " + left.front().where;
+    out.verdict = "unexplained";
+  } else if (chosen.empty()) {
+    out.verdict = "consistent";
+  } else if (!out.ambiguity_experiment.empty()) {
+    out.verdict = "ambiguous";
+  } else {
+    out.verdict = "explained";
+  }
+  if (plot) fill_plot(baseline.fit.p, cur.fit.p, *plot);
+  return out;
+}
+
+}  // namespace
+
+AuditResult run_audit(const recording::Recording& rec, const AuditOptions& opt, PlotData* plot) {
+  Auditor a(rec, opt);
+  return a.run(plot);
+}
+
+}  // namespace hrg::audit

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The recording cut into what the fit uses: free-decay segments averaged into
+// short blocks, excitation segments reduced to their mean wave frequency, and
+// the switching edges. Signals are turned into a frame rotating at the
+// carrier estimate so that what is left in them is slow.
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "recording/recording.hpp"
+
+namespace hrg::audit::detail {
+
+using cplx = std::complex<double>;
+
+struct Block {
+  double t_s = 0.0;                     // mean sample time
+  double m2 = 0.0, m3 = 0.0, m4 = 0.0;  // central moments of the sample times (s^k)
+  double n = 0.0;                       // samples in the block
+  cplx x, y;                            // mean derotated envelopes X = cx - i sx, Y = cy - i sy
+  double temp_c = 0.0;
+  double rate_rad_s = 0.0;
+  double a2_v2 = 0.0;      // measured a_A^2
+  double theta_rad = 0.0;  // measured pattern angle (continuous)
+};
+
+struct FreeSegment {
+  std::size_t first_block = 0, n_blocks = 0;
+  std::size_t first_row = 0, last_row = 0;
+  double t0_s = 0.0, t1_s = 0.0;
+  bool heldout = false;
+};
+
+// Mean wave frequency over one excitation segment.
+struct ForcedSegment {
+  std::size_t first_row = 0, last_row = 0;
+  double t0_s = 0.0, t1_s = 0.0;
+  double freq_rad_s = 0.0;              // (phase_end - phase_start)/duration in the carrier frame
+  double se_rad_s = 0.0;                // from the white noise
+  double mean_c4 = 0.0, mean_s4 = 0.0;  // mean cos/sin 4 theta
+  double theta0_rad = 0.0, theta1_rad = 0.0;
+  double mean_v2 = 0.0;  // mean pump_v^2
+  double mean_a2 = 0.0;  // mean a_A^2
+  double mean_temp_c = 0.0;
+  double mean_rate_rad_s = 0.0;
+};
+
+// A switching of exc between a free-decay segment and an excitation segment.
+struct Edge {
+  std::size_t free_segment = 0;          // index into free segments
+  bool at_start = false;                 // edge at the start of the free segment (exc 1 -> 0)
+  std::vector<std::size_t> forced_rows;  // nearest excitation rows, nearest first
+  double pump_v = 0.0;
+};
+
+struct Dataset {
+  std::vector<Block> blocks;
+  std::vector<FreeSegment> free;
+  std::vector<ForcedSegment> forced;
+  std::vector<Edge> edges;
+  // Per-row derotated envelopes (for the edges) and times.
+  std::vector<double> t_s;
+  std::vector<cplx> x, y;
+  std::vector<double> frame_phase_rad;  // derotation applied at each row
+  double carrier_rad_s = 0.0;           // frame frequency minus the metadata f_ref, rad/s
+  double f_ref_hz = 0.0;
+  double angular_gain = 0.0;
+  double noise_v = 0.0;  // per-sample, per-quadrature white noise
+  double temp_ref_c = 0.0;
+  bool has_temp = false, has_pump = false, has_rate = false;
+  double temp_span_c = 0.0, a2_span_v2 = 0.0, rate_span_rad_s = 0.0;
+  int samples_per_block = 1;
+  std::vector<std::string> notes;
+};
+
+Dataset build_dataset(const recording::Recording& rec, int max_blocks);
+
+}  // namespace hrg::audit::detail

@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: MIT
+#include "model.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "dsp/wave_variables.hpp"
+
+namespace hrg::audit::detail {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+const cplx kI(0.0, 1.0);
+
+Mat2 mul(const Mat2& a, const Mat2& b) {
+  return {a[0] * b[0] + a[1] * b[2], a[0] * b[1] + a[1] * b[3], a[2] * b[0] + a[3] * b[2],
+          a[2] * b[1] + a[3] * b[3]};
+}
+
+struct Inputs {
+  double rate_rad_s, temp_c, a2_v2;
+};
+
+// Dynamics matrix of the model for one set of slow inputs.
+Mat2 dynamics(const Params& p, const Dataset& d, const Inputs& in) {
+  const double dT = in.temp_c - d.temp_ref_c;
+  const double dw0 =
+      p[kDw0] + 2.0 * kPi * p[kDuff] * in.a2_v2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
+  const double s = (1.0 + p[kNld] * in.a2_v2) * (1.0 + p[kTd] * dT);
+  const double ok = in.rate_rad_s * p[kK];
+  return {kI * (dw0 + p[kDwC]) - s * (p[kNu] + p[kDnuC]), kI * p[kDwS] - s * p[kDnuS] + ok,
+          kI * p[kDwS] - s * p[kDnuS] - ok, kI * (dw0 - p[kDwC]) - s * (p[kNu] - p[kDnuC])};
+}
+
+// Pickoff chain: X_m = X, Y_m = (1+g) e^{-i phi} (Y cos2b + X sin2b).
+Mat2 pickoff(const Params& p) {
+  const cplx gy = (1.0 + p[kGain]) * std::polar(1.0, -p[kPhase]);
+  return {1.0, 0.0, gy * std::sin(2.0 * p[kMis]), gy * std::cos(2.0 * p[kMis])};
+}
+
+// Mean of exp(A tau) over the block's sample times (central moments m2..m4).
+Mat2 block_mean(const Mat2& a, const Block& b) {
+  const Mat2 a2 = mul(a, a);
+  const Mat2 a3 = mul(a2, a);
+  const Mat2 a4 = mul(a2, a2);
+  Mat2 m;
+  for (int k = 0; k < 4; ++k) {
+    m[k] = a2[k] * (b.m2 / 2.0) + a3[k] * (b.m3 / 6.0) + a4[k] * (b.m4 / 24.0);
+  }
+  m[0] += 1.0;
+  m[3] += 1.0;
+  return m;
+}
+
+Inputs inputs_of(const Block& b) { return {b.rate_rad_s, b.temp_c, b.a2_v2}; }
+Inputs mid_inputs(const Block& a, const Block& b) {
+  return {0.5 * (a.rate_rad_s + b.rate_rad_s), 0.5 * (a.temp_c + b.temp_c),
+          0.5 * (a.a2_v2 + b.a2_v2)};
+}
+
+// Block operators G_b = C M_b Phi_b of one segment.
+void segment_operators(const Dataset& d, const Params& p, const FreeSegment& s,
+                       std::vector<Mat2>& g) {
+  const Mat2 c = pickoff(p);
+  g.resize(s.n_blocks);
+  Mat2 phi{1.0, 0.0, 0.0, 1.0};
+  for (std::size_t k = 0; k < s.n_blocks; ++k) {
+    const Block& b = d.blocks[s.first_block + k];
+    if (k > 0) {
+      const Block& prev = d.blocks[s.first_block + k - 1];
+      phi = mul(expm2(dynamics(p, d, mid_inputs(prev, b)), b.t_s - prev.t_s), phi);
+    }
+    g[k] = mul(c, mul(block_mean(dynamics(p, d, inputs_of(b)), b), phi));
+  }
+}
+
+// Least-squares initial state over blocks [k0, k1).
+std::array<cplx, 2> solve_state(const Dataset& d, const FreeSegment& s, const std::vector<Mat2>& g,
+                                std::size_t k0, std::size_t k1) {
+  cplx n00 = 0, n01 = 0, n11 = 0, r0 = 0, r1 = 0;
+  for (std::size_t k = k0; k < k1; ++k) {
+    const Block& b = d.blocks[s.first_block + k];
+    const Mat2& m = g[k];
+    // N = sum n G^H G, r = sum n G^H y
+    n00 += b.n * (std::conj(m[0]) * m[0] + std::conj(m[2]) * m[2]);
+    n01 += b.n * (std::conj(m[0]) * m[1] + std::conj(m[2]) * m[3]);
+    n11 += b.n * (std::conj(m[1]) * m[1] + std::conj(m[3]) * m[3]);
+    r0 += b.n * (std::conj(m[0]) * b.x + std::conj(m[2]) * b.y);
+    r1 += b.n * (std::conj(m[1]) * b.x + std::conj(m[3]) * b.y);
+  }
+  const cplx n10 = std::conj(n01);
+  const cplx det = n00 * n11 - n01 * n10;
+  if (std::abs(det) == 0.0) return {0.0, 0.0};
+  return {(n11 * r0 - n01 * r1) / det, (n00 * r1 - n10 * r0) / det};
+}
+
+// Phase of the measured wave of a pure standing wave at angle theta.
+double measured_phase(const Params& p, double theta) {
+  const Mat2 c = pickoff(p);
+  const cplx x = c[0] * std::cos(2.0 * theta) + c[1] * std::sin(2.0 * theta);
+  const cplx y = c[2] * std::cos(2.0 * theta) + c[3] * std::sin(2.0 * theta);
+  return dsp::wave_variables<double>({x.real(), -x.imag(), y.real(), -y.imag()}).phase_rad;
+}
+
+}  // namespace
+
+double param_scale(int p) {
+  static constexpr double kScale[kParamCount] = {1e-3, 1e-3, 1e-4, 1e-4, 1e-4, 1e-4, 1e-3, 1e-3,
+                                                 1e-3, 1e-3, 1e-4, 1e-3, 1e-1, 1e-3, 1e-6};
+  return kScale[p];
+}
+
+Mat2 expm2(const Mat2& a, double t) {
+  const cplx tr = 0.5 * (a[0] + a[3]);
+  const Mat2 b{(a[0] - tr) * t, a[1] * t, a[2] * t, (a[3] - tr) * t};
+  const cplx s2 = b[0] * b[0] + b[1] * b[2];
+  const cplx s = std::sqrt(s2);
+  cplx ch, shs;
+  if (std::abs(s) < 1e-4) {
+    ch = 1.0 + s2 / 2.0 + s2 * s2 / 24.0;
+    shs = 1.0 + s2 / 6.0 + s2 * s2 / 120.0;
+  } else {
+    ch = std::cosh(s);
+    shs = std::sinh(s) / s;
+  }
+  const cplx e = std::exp(tr * t);
+  return {e * (ch + shs * b[0]), e * shs * b[1], e * shs * b[2], e * (ch + shs * b[3])};
+}
+
+std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
+  std::vector<double> r;
+  r.reserve(d.forced.size());
+  for (const auto& f : d.forced) {
+    const double dT = f.mean_temp_c - d.temp_ref_c;
+    double w = p[kDw0] + p[kDwC] * f.mean_c4 + p[kDwS] * f.mean_s4 +
+               2.0 * kPi * p[kDuff] * f.mean_a2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT +
+               2.0 * kPi * p[kEs] * f.mean_v2;
+    double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);
+    dm = std::remainder(dm, kPi);
+    w += dm / (f.t1_s - f.t0_s);
+    r.push_back(f.freq_rad_s - w);
+  }
+  return r;
+}
+
+void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vector<double>& res,
+              std::vector<std::array<cplx, 2>>* pred) {
+  res.clear();
+  if (pred) pred->assign(d.blocks.size(), {cplx(0.0), cplx(0.0)});
+  std::vector<Mat2> g;
+  const double inv_sigma = 1.0 / d.noise_v;
+  for (const auto& s : d.free) {
+    if (o.heldout_only != s.heldout) {
+      if (o.heldout_only || !o.include_heldout) continue;
+    }
+    segment_operators(d, p, s, g);
+    std::size_t k_fit1 = s.n_blocks, k_res0 = 0;
+    if (o.heldout_only) {
+      k_fit1 = std::max<std::size_t>(2, s.n_blocks / 5);
+      k_res0 = k_fit1;
+    }
+    const auto z = solve_state(d, s, g, 0, k_fit1);
+    for (std::size_t k = k_res0; k < s.n_blocks; ++k) {
+      const Block& b = d.blocks[s.first_block + k];
+      const cplx px = g[k][0] * z[0] + g[k][1] * z[1];
+      const cplx py = g[k][2] * z[0] + g[k][3] * z[1];
+      const double w = std::sqrt(b.n) * inv_sigma;
+      res.push_back(w * (b.x - px).real());
+      res.push_back(w * (b.x - px).imag());
+      res.push_back(w * (b.y - py).real());
+      res.push_back(w * (b.y - py).imag());
+      if (pred) (*pred)[s.first_block + k] = {px, py};
+    }
+  }
+  if (o.forced_sigma_rad_s > 0.0 && !o.heldout_only) {
+    for (double r : forced_residuals(d, p))
+      res.push_back(r / o.forced_sigma_rad_s);
+  }
+}
+
+std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p, std::size_t seg,
+                                              const std::vector<std::size_t>& rows,
+                                              double* wave_phase_rad) {
+  const FreeSegment& s = d.free[seg];
+  std::vector<Mat2> g;
+  segment_operators(d, p, s, g);
+  const auto z0 = solve_state(d, s, g, 0, s.n_blocks);
+  // Propagate the state to the last block for rows after the segment.
+  Mat2 phi{1.0, 0.0, 0.0, 1.0};
+  for (std::size_t k = 1; k < s.n_blocks; ++k) {
+    const Block& a = d.blocks[s.first_block + k - 1];
+    const Block& b = d.blocks[s.first_block + k];
+    phi = mul(expm2(dynamics(p, d, mid_inputs(a, b)), b.t_s - a.t_s), phi);
+  }
+  const Block& first = d.blocks[s.first_block];
+  const Block& last = d.blocks[s.first_block + s.n_blocks - 1];
+  const std::array<cplx, 2> zl{phi[0] * z0[0] + phi[1] * z0[1], phi[2] * z0[0] + phi[3] * z0[1]};
+  const Mat2 c = pickoff(p);
+  std::vector<std::array<cplx, 2>> out;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double t = d.t_s[rows[i]];
+    const bool before = t < first.t_s;
+    const Block& ref = before ? first : last;
+    const auto& zr = before ? z0 : zl;
+    const Mat2 e = expm2(dynamics(p, d, inputs_of(ref)), t - ref.t_s);
+    const cplx zx = e[0] * zr[0] + e[1] * zr[1];
+    const cplx zy = e[2] * zr[0] + e[3] * zr[1];
+    if (i == 0 && wave_phase_rad) {
+      *wave_phase_rad =
+          dsp::wave_variables<double>({zx.real(), -zx.imag(), zy.real(), -zy.imag()}).phase_rad;
+    }
+    out.push_back({c[0] * zx + c[1] * zy, c[2] * zx + c[3] * zy});
+  }
+  return out;
+}
+
+}  // namespace hrg::audit::detail

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The fitted model: the seed's averaged equations (physics.md section 2) in
+// the carrier frame, Z' = A Z with
+//   A = i(dw0 I + dw [c4w s4w; s4w -c4w]) - s (nu I + [dnuC dnuS; dnuS -dnuC])
+//       + Omega K [0 1; -1 0],
+// measured through the pickoff matrix C (gain, phase, misalignment), plus the
+// catalogue's extensions as extra parameters that start at zero. Each
+// free-decay segment has its own initial state, solved by linear least
+// squares inside every evaluation (variable projection).
+
+#include <array>
+#include <complex>
+#include <vector>
+
+#include "dataset.hpp"
+
+namespace hrg::audit::detail {
+
+enum Param : int {
+  kDw0,    // wave frequency minus the carrier frame, rad/s
+  kNu,     // mean amplitude decay rate, 1/s
+  kDnuC,   // nu dmu cos 4th_mu, 1/s
+  kDnuS,   // nu dmu sin 4th_mu, 1/s
+  kDwC,    // dw cos 4th_w (half split), rad/s
+  kDwS,    // dw sin 4th_w, rad/s
+  kK,      // angular gain
+  kGain,   // pickoff_gain_mismatch, -
+  kPhase,  // pickoff_phase_mismatch, rad
+  kMis,    // pickoff_misalignment, rad (physical)
+  kDuff,   // duffing_stiffness, Hz/V^2
+  kNld,    // nonlinear_damping, 1/V^2
+  kTf,     // thermal_frequency, ppm/degC
+  kTd,     // thermal_damping, 1/degC
+  kEs,     // electrostatic_spring, Hz/V^2
+  kParamCount
+};
+
+using Params = std::array<double, kParamCount>;
+using Mask = std::array<bool, kParamCount>;
+
+// Typical magnitude of each parameter: sets finite-difference steps and scaling.
+double param_scale(int p);
+
+struct EvalOptions {
+  bool include_heldout = true;      // fit segments marked heldout too
+  bool heldout_only = false;        // residuals of held-out segments, state from their first 20 %
+  double forced_sigma_rad_s = 0.0;  // 0: excitation segments not used
+};
+
+// Residual vector in units of the noise: 4 per block (re/im of x, y) scaled
+// by sqrt(n)/noise, then one per excitation segment (frequency, / sigma).
+// `pred`, when given, receives the predicted measured block means (x, y).
+void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vector<double>& res,
+              std::vector<std::array<cplx, 2>>* pred = nullptr);
+
+// Frequency residuals (rad/s) of the excitation segments alone.
+std::vector<double> forced_residuals(const Dataset& d, const Params& p);
+
+// exp(A t) of a 2x2 complex matrix (closed form).
+using Mat2 = std::array<cplx, 4>;  // row-major
+Mat2 expm2(const Mat2& a, double t);
+
+// The model's measured envelopes at row times `rows` of free segment `seg`
+// (extrapolated with the segment's own dynamics and fitted initial state).
+std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p, std::size_t seg,
+                                              const std::vector<std::size_t>& rows,
+                                              double* wave_phase_rad);
+
+}  // namespace hrg::audit::detail

@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: MIT
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "audit/audit.hpp"
+
+namespace hrg::audit {
+
+namespace {
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string str(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      o += '\\';
+      o += c;
+    } else if (c == '\n') {
+      o += "\\n";
+    } else {
+      o += c;
+    }
+  }
+  return o + "\"";
+}
+
+}  // namespace
+
+std::string to_json(const AuditResult& r) {
+  std::string j = "{\n  \"verdict\": " + str(r.verdict) + ",\n";
+  const auto& b = r.baseline;
+  j += "  \"baseline\": {\"params\": {\"f_hz\": " + num(b.f_hz) + ", \"q\": " + num(b.q) +
+       ", \"nu_per_s\": " + num(b.nu_per_s) + ", \"dmu\": " + num(b.dmu) +
+       ", \"theta_mu_deg\": " + num(b.theta_mu_deg) + ", \"split_hz\": " + num(b.split_hz) +
+       ", \"theta_w_deg\": " + num(b.theta_w_deg) + ", \"angular_gain\": " + num(b.angular_gain) +
+       "}, \"heldout_rms\": " + num(r.heldout_rms_v) + ", \"fit_rms\": " + num(r.fit_rms_before_v) +
+       ", \"noise_v\": " + num(r.noise_v) + "},\n";
+  j += "  \"locations\": [";
+  for (std::size_t i = 0; i < r.locations.size(); ++i) {
+    const auto& l = r.locations[i];
+    j += std::string(i ? ",\n    " : "\n    ") + "{\"signal\": " + str(l.signal) +
+         ", \"where\": " + str(l.where) + ", \"score\": " + num(l.score) + "}";
+  }
+  j += r.locations.empty() ? "],\n" : "\n  ],\n";
+  j += "  \"findings\": [";
+  for (std::size_t i = 0; i < r.findings.size(); ++i) {
+    const auto& f = r.findings[i];
+    const auto& info = effect_info(f.effect);
+    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(info.id) +
+         ", \"explanation\": " + str(info.explanation) + ", \"params\": {" + str(info.param) +
+         ": " + num(f.value) + "}, \"uncertainty\": {" + str(info.param) + ": " + num(f.sigma) +
+         "}, \"delta_bic\": " + num(f.delta_bic) +
+         ", \"heldout_rms_before\": " + num(f.heldout_rms_before_v) +
+         ", \"heldout_rms_after\": " + num(f.heldout_rms_after_v) +
+         ", \"impact\": " + str(f.impact) + "}";
+  }
+  j += r.findings.empty() ? "],\n" : "\n  ],\n";
+  j += "  \"alternatives\": [";
+  for (std::size_t i = 0; i < r.alternatives.size(); ++i) {
+    const auto& a = r.alternatives[i];
+    const auto& info = effect_info(a.effect);
+    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(info.id) +
+         ", \"params\": {" + str(info.param) + ": " + num(a.value) +
+         "}, \"delta_bic\": " + num(a.delta_bic) + ", \"note\": " + str(a.note) + "}";
+  }
+  j += r.alternatives.empty() ? "]" : "\n  ]";
+  if (!r.ambiguity_experiment.empty()) {
+    j += ",\n  \"separating_experiment\": " + str(r.ambiguity_experiment);
+  }
+  if (!r.unexplained_note.empty()) j += ",\n  \"unexplained\": " + str(r.unexplained_note);
+  j += ",\n  \"candidates\": [";
+  for (std::size_t i = 0; i < r.candidates.size(); ++i) {
+    const auto& c = r.candidates[i];
+    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(effect_info(c.effect).id) +
+         ", \"testable\": " + (c.testable ? "true" : "false") + ", \"value\": " + num(c.value) +
+         ", \"sigma\": " + num(c.sigma) + ", \"threshold\": " + num(c.threshold) +
+         ", \"delta_bic\": " + num(c.delta_bic) + "}";
+  }
+  j += r.candidates.empty() ? "]" : "\n  ]";
+  j += ",\n  \"notes\": [";
+  for (std::size_t i = 0; i < r.notes.size(); ++i)
+    j += (i ? ", " : "") + str(r.notes[i]);
+  j += "]\n}\n";
+  return j;
+}
+
+std::string to_text(const AuditResult& r, const std::string& source) {
+  std::string t;
+  char buf[512];
+  t += "VERDICT: " + r.verdict + "   (" + source + ")\n";
+  if (r.findings.empty()) {
+    t += "  The seed's model explains the recording to the noise level; no left-out physics is "
+         "justified.\n";
+  }
+  for (const auto& f : r.findings) {
+    const auto& info = effect_info(f.effect);
+    std::snprintf(buf, sizeof buf, "  FOUND %s: %s = %.4g +/- %.2g %s (delta BIC %.1f)\n", info.id,
+                  info.param, f.value, f.sigma, info.unit, f.delta_bic);
+    t += buf;
+    t += "    physics: " + std::string(info.explanation) + "\n";
+    t += "    impact:  " + f.impact + "\n";
+  }
+  if (!r.ambiguity_experiment.empty()) {
+    t += "  AMBIGUOUS: " + r.ambiguity_experiment + "\n";
+  }
+  for (const auto& a : r.alternatives) {
+    std::snprintf(buf, sizeof buf, "  alternative %s: %.4g %s (delta BIC %.1f): %s\n",
+                  effect_info(a.effect).id, a.value, effect_info(a.effect).unit, a.delta_bic,
+                  a.note.c_str());
+    t += buf;
+  }
+  if (!r.unexplained_note.empty()) t += "  UNEXPLAINED: " + r.unexplained_note + "\n";
+  t += "\nWhere the baseline misfits:\n";
+  if (r.locations.empty()) t += "  nowhere above 5 sigma\n";
+  for (const auto& l : r.locations) {
+    std::snprintf(buf, sizeof buf, "  [score %.3g] %s: %s\n", l.score, l.signal.c_str(),
+                  l.where.c_str());
+    t += buf;
+  }
+  std::snprintf(buf, sizeof buf,
+                "\nFit (free-decay rms per sample): baseline %.3g V -> final %.3g V; held-out "
+                "segments %.3g V -> %.3g V; white noise %.3g V\n",
+                r.fit_rms_before_v, r.fit_rms_after_v, r.heldout_rms_v, r.heldout_rms_final_v,
+                r.noise_v);
+  t += buf;
+  const auto& b = r.baseline;
+  std::snprintf(buf, sizeof buf,
+                "Baseline: f = %.6f Hz, Q = %.4g (nu = %.4g 1/s), dmu = %.3g at %.1f deg, "
+                "split = %.3g mHz at %.1f deg, K = %.4g\n",
+                b.f_hz, b.q, b.nu_per_s, b.dmu, b.theta_mu_deg, b.split_hz * 1e3, b.theta_w_deg,
+                b.angular_gain);
+  t += buf;
+  std::snprintf(buf, sizeof buf,
+                "Data: %d free-decay segments (%d held out), %d excitation segments, %d blocks of "
+                "%d samples, effective samples %.0f\n",
+                r.free_segments, r.heldout_segments, r.forced_segments, r.blocks,
+                r.samples_per_block, r.n_effective);
+  t += buf;
+  for (const auto& n : r.notes)
+    t += "note: " + n + "\n";
+  return t;
+}
+
+}  // namespace hrg::audit

@@ -1,0 +1,291 @@
+// SPDX-License-Identifier: MIT
+#include "selection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+
+#include <Eigen/Dense>
+
+#include "dsp/wave_variables.hpp"
+
+namespace hrg::audit::detail {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+using Vec4 = Eigen::Vector4d;
+
+Vec4 real4(const std::array<cplx, 2>& z) {
+  return {z[0].real(), z[0].imag(), z[1].real(), z[1].imag()};
+}
+std::array<cplx, 2> cplx2(const Vec4& v) { return {cplx(v(0), v(1)), cplx(v(2), v(3))}; }
+
+// One switching edge seen from the free-decay model: the jump J (forced-side
+// quadratic extrapolated to the edge, minus the model) with the component
+// along the force-driven slope removed (the switching instant within the
+// sample interval is not known, so a jump along the slope is not evidence).
+struct EdgeJump {
+  Vec4 j;                // projected jump (re/im x, re/im y), V
+  Eigen::Matrix4d proj;  // projector used
+  double var = 0.0;      // noise variance of each real component of j before projection, V^2
+  cplx phasor;           // e^{i phi} of the wave at the edge
+  double pump_v = 0.0;
+};
+
+EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
+  EdgeJump ej;
+  double phase = 0.0;
+  const auto pred = predict_rows(d, p, e.free_segment, e.forced_rows, &phase);
+  const std::size_t near = e.forced_rows.front();
+  const std::size_t free_row = e.at_start ? near + 1 : near - 1;
+  const double t_e = 0.5 * (d.t_s[near] + d.t_s[free_row]);
+  const double dt = std::abs(d.t_s[near] - d.t_s[free_row]);
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<cplx, 3, 2> b = Eigen::Matrix<cplx, 3, 2>::Zero();
+  for (std::size_t j = 0; j < e.forced_rows.size(); ++j) {
+    const std::size_t row = e.forced_rows[j];
+    const double tau = (d.t_s[row] - t_e) / dt;
+    const Eigen::Vector3d f(1.0, tau, tau * tau);
+    s += f * f.transpose();
+    b.row(0) += f(0) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
+    b.row(1) += f(1) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
+    b.row(2) += f(2) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
+  }
+  const Eigen::Matrix3d si = s.inverse();
+  const Eigen::Matrix<cplx, 3, 2> coef = si.cast<cplx>() * b;
+  const Vec4 r0 = real4({coef(0, 0), coef(0, 1)});
+  const Vec4 r1 = real4({coef(1, 0), coef(1, 1)});
+  ej.proj = Eigen::Matrix4d::Identity();
+  if (r1.squaredNorm() > 0.0) ej.proj -= r1 * r1.transpose() / r1.squaredNorm();
+  ej.j = ej.proj * r0;
+  ej.var = si(0, 0) * d.noise_v * d.noise_v;
+  ej.phasor = std::polar(1.0, phase);
+  ej.pump_v = std::max(e.pump_v, 1e-12);
+  return ej;
+}
+
+// Real 4x4 map of c (re/im c_x, re/im c_y) to the edge's feedthrough V e^{i phi} c.
+Eigen::Matrix4d feed_map(const EdgeJump& ej) {
+  const double a = ej.pump_v * ej.phasor.real(), bb = ej.pump_v * ej.phasor.imag();
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  m.block<2, 2>(0, 0) << a, -bb, bb, a;
+  m.block<2, 2>(2, 2) << a, -bb, bb, a;
+  return ej.proj * m;
+}
+
+}  // namespace
+
+FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
+  FeedStat fs;
+  if (d.edges.size() < 3) return fs;
+  std::vector<EdgeJump> jumps;
+  // Only the switch-offs: there the forces were steady and the free decay
+  // that follows is clean, while a control loop starting up makes the
+  // switch-ons transients that no low-order extrapolation follows.
+  std::vector<const Edge*> used;
+  for (const auto& e : d.edges) {
+    if (e.at_start) used.push_back(&e);
+  }
+  if (used.size() < 3) return fs;
+  for (const auto* e : used)
+    jumps.push_back(edge_jump(d, p, *e));
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    for (std::size_t i = 0; i < jumps.size(); ++i) {
+      std::fprintf(stderr, "edge %zu t=%.3f |J|/sd=%.2f V=%.2f J=%s\n", i,
+                   d.t_s[used[i]->forced_rows[0]], jumps[i].j.norm() / std::sqrt(jumps[i].var),
+                   jumps[i].pump_v,
+                   fmt("%.2e %.2e %.2e", jumps[i].j(0), jumps[i].j(1), jumps[i].j(2)).c_str());
+    }
+  }
+  const auto n = static_cast<double>(jumps.size());
+  // Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
+  // (the wave phase is defined modulo pi), minus its noise expectation.
+  std::array<cplx, 2> m{};
+  double s4 = 0.0;
+  for (const auto& ej : jumps) {
+    const cplx u = std::conj(ej.phasor) / ej.pump_v;
+    const auto z = cplx2(ej.j);
+    const double v = ej.var / (ej.pump_v * ej.pump_v);
+    const Eigen::Matrix4d& pr = ej.proj;
+    for (int k = 0; k < 2; ++k) {
+      const cplx w = z[static_cast<std::size_t>(k)] * u;
+      const cplx bias =
+          v * cplx(pr(2 * k, 2 * k) - pr(2 * k + 1, 2 * k + 1), 2.0 * pr(2 * k, 2 * k + 1)) *
+          std::conj(ej.phasor * ej.phasor);
+      m[static_cast<std::size_t>(k)] += (w * w - bias) / n;
+    }
+    s4 += 4.0 * v * v / n;
+  }
+  const double var_m = 2.0 * s4 / n;
+  fs.dchi2 = 2.0 * (std::norm(m[0]) + std::norm(m[1])) / var_m;
+  fs.testable = true;
+  fs.edges = static_cast<int>(n);
+  fs.threshold = std::pow(4.0 * ln_neff * s4 / n, 0.25);
+  // Estimate: least squares with one sign per edge, from the moment estimate.
+  Vec4 best_c = Vec4::Zero();
+  double best_cost = 1e300;
+  for (double rel : {1.0, -1.0}) {
+    const cplx cx = std::sqrt(m[0]), cy = rel * std::sqrt(m[1]);
+    Vec4 c = real4({cx, cy});
+    double cost = 0.0;
+    for (int it = 0; it < 4; ++it) {
+      Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+      Vec4 rhs = Vec4::Zero();
+      cost = 0.0;
+      for (const auto& ej : jumps) {
+        const Eigen::Matrix4d f = feed_map(ej);
+        const double sgn = ej.j.dot(f * c) >= 0.0 ? 1.0 : -1.0;
+        a += f.transpose() * f / ej.var;
+        rhs += sgn * f.transpose() * ej.j / ej.var;
+        cost += (ej.j - sgn * f * c).squaredNorm() / ej.var;
+      }
+      c = a.ldlt().solve(rhs);
+      if (it == 3) {
+        const Eigen::Matrix4d cov = a.inverse();
+        fs.sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0);
+      }
+    }
+    if (cost < best_cost) best_cost = cost, best_c = c;
+  }
+  fs.c_x = std::hypot(best_c(0), best_c(1));
+  fs.c_y = std::hypot(best_c(2), best_c(3));
+  return fs;
+}
+
+double effective_fraction(const std::vector<double>& res, std::size_t n_free_res) {
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i + 4 < n_free_res; ++i)
+    num += res[i] * res[i + 4];
+  for (std::size_t i = 0; i < n_free_res; ++i)
+    den += res[i] * res[i];
+  if (den <= 0.0) return 1.0;
+  const double rho = num / den;
+  if (rho <= 0.0) return 1.0;
+  return std::clamp((1.0 - rho) / (1.0 + rho), 0.02, 1.0);
+}
+
+std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
+                             double forced_sigma, const FeedStat& ft) {
+  std::vector<Location> out;
+  // Per free segment: excess chi^2 over its degrees of freedom.
+  std::size_t k = 0;
+  struct SegScore {
+    double excess;
+    std::size_t i;
+  };
+  std::vector<SegScore> segs;
+  // Harmonics of the amplitude and quadrature residuals against 4 theta.
+  double sa[3][3] = {}, sq[3][3] = {};
+  double ya[3] = {}, yq[3] = {}, saa = 0.0, sqq = 0.0;
+  std::vector<std::array<cplx, 2>> pred;
+  std::vector<double> tmp;
+  evaluate(d, p, EvalOptions{}, tmp, &pred);
+  for (std::size_t si = 0; si < d.free.size(); ++si) {
+    const auto& s = d.free[si];
+    double chi = 0.0;
+    for (std::size_t b = 0; b < s.n_blocks && k + 3 < res.size(); ++b, k += 4) {
+      chi += res[k] * res[k] + res[k + 1] * res[k + 1] + res[k + 2] * res[k + 2] +
+             res[k + 3] * res[k + 3];
+      const Block& bl = d.blocks[s.first_block + b];
+      const auto& pr = pred[s.first_block + b];
+      const auto wm =
+          dsp::wave_variables<double>({bl.x.real(), -bl.x.imag(), bl.y.real(), -bl.y.imag()});
+      const auto wp =
+          dsp::wave_variables<double>({pr[0].real(), -pr[0].imag(), pr[1].real(), -pr[1].imag()});
+      const double sig = d.noise_v / std::sqrt(bl.n);
+      const double da = (wm.a_A - wp.a_A) / sig;
+      const double dq = (wm.a_B - wp.a_B) / sig;
+      const double f[3] = {1.0, std::cos(4.0 * bl.theta_rad), std::sin(4.0 * bl.theta_rad)};
+      for (int i = 0; i < 3; ++i) {
+        ya[i] += f[i] * da, yq[i] += f[i] * dq;
+        for (int j = 0; j < 3; ++j)
+          sa[i][j] += f[i] * f[j], sq[i][j] += f[i] * f[j];
+      }
+      saa += da * da, sqq += dq * dq;
+    }
+    const double dof = 4.0 * static_cast<double>(s.n_blocks);
+    segs.push_back({chi - dof, si});
+  }
+  std::sort(segs.begin(), segs.end(), [](auto a, auto b) { return a.excess > b.excess; });
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, segs.size()); ++i) {
+    const auto& s = d.free[segs[i].i];
+    const double z = segs[i].excess / std::sqrt(8.0 * static_cast<double>(s.n_blocks));
+    if (z < 5.0) break;
+    out.push_back({"cx_v,sx_v,cy_v,sy_v",
+                   fmt("free decay %.2f-%.2f s", s.t0_s, s.t1_s) +
+                       fmt(" (mean |rate| %.3g deg/s)",
+                           std::abs(d.blocks[s.first_block].rate_rad_s) * 180.0 / kPi),
+                   segs[i].excess});
+  }
+  // 4-theta harmonic explained chi^2 (projection onto cos4, sin4 after the mean).
+  auto harmonic = [](double s[3][3], double y[3]) {
+    Eigen::Matrix3d a;
+    Eigen::Vector3d b;
+    for (int i = 0; i < 3; ++i) {
+      b(i) = y[i];
+      for (int j = 0; j < 3; ++j)
+        a(i, j) = s[i][j];
+    }
+    if (std::abs(a.determinant()) < 1e-9 * std::pow(a(0, 0), 3)) return std::array<double, 3>{};
+    const Eigen::Vector3d c = a.ldlt().solve(b);
+    const double explained = b.dot(c) - y[0] * y[0] / std::max(s[0][0], 1e-30);
+    return std::array<double, 3>{explained, c(1), c(2)};
+  };
+  const auto ha = harmonic(sa, ya);
+  const auto hq = harmonic(sq, yq);
+  const double sig1 = d.noise_v;
+  if (ha[0] > 25.0) {
+    const double amp = std::hypot(ha[1], ha[2]);
+    out.push_back({"a_A (measured amplitude)",
+                   fmt("4-theta harmonic of the amplitude residual, %.3g V at 4theta = %.0f deg",
+                       amp * sig1, std::atan2(ha[2], ha[1]) * 180.0 / kPi),
+                   ha[0]});
+  }
+  if (hq[0] > 25.0) {
+    const double amp = std::hypot(hq[1], hq[2]);
+    out.push_back({"a_B (quadrature)",
+                   fmt("4-theta harmonic of the quadrature residual, %.3g V at 4theta = %.0f deg",
+                       amp * sig1, std::atan2(hq[2], hq[1]) * 180.0 / kPi),
+                   hq[0]});
+  }
+  // Excitation segments: mean frequency offset while the pump is on.
+  if (forced_sigma > 0.0 && !d.forced.empty()) {
+    const auto fr = forced_residuals(d, p);
+    double m = 0.0, v2 = 0.0;
+    for (std::size_t i = 0; i < fr.size(); ++i)
+      m += fr[i], v2 += d.forced[i].mean_v2;
+    m /= static_cast<double>(fr.size());
+    v2 /= static_cast<double>(fr.size());
+    const double chi = m * m * static_cast<double>(fr.size()) / (forced_sigma * forced_sigma);
+    if (chi > 25.0) {
+      out.push_back({"wave frequency",
+                     fmt("excitation segments (pump on, mean pump_v^2 %.3g V^2): %.3g mHz "
+                         "off the free-decay frequency",
+                         v2, m / (2.0 * kPi) * 1e3),
+                     chi});
+    }
+  }
+  if (ft.testable && ft.dchi2 > 25.0) {
+    out.push_back({"cx_v,sx_v,cy_v,sy_v",
+                   fmt("switching instants of exc (%.0f edges): steps of %.3g V/V of pump "
+                       "voltage",
+                       ft.edges, std::max(ft.c_x, ft.c_y)),
+                   ft.dchi2});
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });
+  (void)saa;
+  (void)sqq;
+  return out;
+}
+
+}  // namespace hrg::audit::detail
