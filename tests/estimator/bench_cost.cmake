@@ -1,0 +1,23 @@
+# SPDX-License-Identifier: MIT
+# Instructions per estimator step, counted by callgrind (deterministic, x86-64
+# host build; a Cortex-M7 with a double FPU runs a comparable count).
+function(count op fn count per what)
+  set(out_file ${WORK_DIR}/callgrind.estimator.${op})
+  execute_process(COMMAND ${VALGRIND} --tool=callgrind --callgrind-out-file=${out_file}
+      --toggle-collect=${fn} ${BENCH} ${op} ${count}
+    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "callgrind run of ${BENCH} ${op} failed (${rc})")
+  endif()
+  file(STRINGS ${out_file} totals REGEX "^(summary|totals):")
+  list(GET totals 0 line)
+  string(REGEX MATCH "[0-9]+" ir "${line}")
+  math(EXPR each "${ir} / ${per}")
+  message("estimator ${what}: ${ir} instructions / ${per} = ${each} per call")
+endfunction()
+# add_sample over 3000-sample windows, 4 repetitions
+count(sample hrg_bench_est_sample 4 12000 "add_sample (1 kHz, settled sample)")
+count(window hrg_bench_est_window 1 1 "end_window + add_window (once per window)")
+count(solve hrg_bench_est_solve 100 100 "solve joint 5x5 (conditioning, LDLT, covariance)")
+count(solve_alt hrg_bench_est_solve 20 20 "solve alternating (eqs. 18-19 to convergence)")
+count(output hrg_bench_est_output 10000 10000 "step_output (1 kHz drift compensation)")

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// Cost of the estimator's steps, for callgrind (bench_cost.cmake counts the
+// instructions inside each hrg_bench_est_* function and divides by its count).
+//   bench_estimator_cost <op> <count>
+//   op: sample | window | solve | solve_alt | output
+#include <estimator/estimator.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "synthetic_decay.hpp"
+
+using namespace hrg::est;
+using namespace hrg::est::test;
+
+namespace {
+constexpr int kWindowSamples = 3000;
+
+std::vector<WaveSample> window_samples(double theta0, double t0) {
+  const SyntheticDecay gen{seed_params(0.2, 0.5), 0.554, 0.0};
+  std::mt19937_64 rng(3);
+  DecayState s{t0, 1.0, 0.0, theta0};
+  std::vector<WaveSample> out;
+  for (int i = 0; i < kWindowSamples; ++i) {
+    gen.step(s, 1e-3);
+    out.push_back(gen.measure(s, 2e-5, rng));
+  }
+  return out;
+}
+}  // namespace
+
+extern "C" {
+// Settled samples only (the settle rule is a comparison).
+__attribute__((noipa)) void hrg_bench_est_sample(WindowAccumulator& acc, const WaveSample* s,
+                                                 int n) {
+  for (int i = 0; i < n; ++i)
+    acc.add_sample(s[i]);
+}
+__attribute__((noipa)) void hrg_bench_est_window(WindowAccumulator& acc, NormalEquations& ls,
+                                                 WindowContribution& w) {
+  if (acc.end_window(w) == Status::ok) ls.add_window(w);
+}
+__attribute__((noipa)) Solution hrg_bench_est_solve(const NormalEquations& ls, Variant v) {
+  return ls.solve(v);
+}
+__attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n) {
+  double c = 0;
+  for (int i = 0; i < n; ++i)
+    c = comp.step(0.001 * i, 0.001, 1e-7, 1e-3);
+  return c;
+}
+}
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: %s sample|window|solve|solve_alt|output <count>\n", argv[0]);
+    return 2;
+  }
+  const char* op = argv[1];
+  const int count = std::atoi(argv[2]);
+  // A well-covered state to solve: 16 windows.
+  NormalEquations ls;
+  WindowAccumulator acc;
+  WindowContribution w;
+  for (int k = 0; k < 16; ++k) {
+    const auto samples = window_samples(0.05 + k * M_PI / 32, 10.0 * k);
+    acc.begin_window(samples.front().t_s - 0.5);
+    const bool last = k == 15;
+    if (last && std::strcmp(op, "sample") == 0) {
+      for (int r = 0; r < count; ++r) {
+        acc.abort_window();
+        acc.begin_window(samples.front().t_s - 0.5);
+        hrg_bench_est_sample(acc, samples.data(), kWindowSamples);
+      }
+    } else {
+      for (const auto& s : samples)
+        acc.add_sample(s);
+    }
+    if (last && std::strcmp(op, "window") == 0) {
+      hrg_bench_est_window(acc, ls, w);
+    } else if (acc.end_window(w) == Status::ok) {
+      ls.add_window(w);
+    }
+  }
+  double sink = 0;
+  if (std::strcmp(op, "solve") == 0 || std::strcmp(op, "solve_alt") == 0) {
+    const Variant v = op[5] == '_' ? Variant::alternating : Variant::joint;
+    for (int r = 0; r < count; ++r)
+      sink += hrg_bench_est_solve(ls, v).p(kDnuC);
+  }
+  if (std::strcmp(op, "output") == 0) {
+    DriftCompensator comp{0.554};
+    comp.set_model(seed_params(0.2, 0.5));
+    sink += hrg_bench_est_output(comp, count);
+  }
+  std::printf("%s %d %.3e\n", op, count, sink);
+  return 0;
+}
