@@ -75,7 +75,7 @@ void Chain<T>::reset() {
   out_ = ChainOutputs{};
   phase_ = 0;
   step_ = phase_step_of_hz(cfg_.f_center_hz, cfg_.sample_rate_hz);
-  excitation_ = false;
+  pump_on_ = forcers_on_ = false;
   ring_up_ = true;
   wave_phase_rad_ = 0.0;
   c2_ = std::cos(2.0 * cfg_.ring_up_theta_rad);
@@ -131,33 +131,38 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
   }
   out_.pll_freq_hz = pll_.update(w.phase_rad, valid, dt_s);
   out_.locked = lock_.update(w.phase_rad, valid);
-  out_.excitation = excitation_;
+  out_.excitation = pump_on_ || forcers_on_;
 
-  if (!excitation_) {
-    // Free decay: drives off, amplitude and quadrature loops hold their state.
-    u_a_v_ = u_q_v_ = u_r_v_ = v0_v_ = 0.0;
-  } else {
-    const double a_set = agc_.setpoint_v();
-    if (ring_up_ && w.a_A > cfg_.ring_up_exit * a_set) ring_up_ = false;
-    if (!ring_up_ && w.a_A < cfg_.ring_up_enter * a_set) ring_up_ = true;
+  const double a_set = agc_.setpoint_v();
+  if (ring_up_ && w.a_A > cfg_.ring_up_exit * a_set) ring_up_ = false;
+  if (!ring_up_ && w.a_A < cfg_.ring_up_enter * a_set) ring_up_ = true;
+  // Pump: at its limit during ring-up (once there is a wave to pump), else
+  // the AGC. Off: zero, AGC holds.
+  v0_v_ = 0.0;
+  if (pump_on_) {
     if (ring_up_) {
-      // Direct drive at resonance along the pattern: the pump alone cannot
-      // start a wave from zero amplitude.
-      u_a_v_ = cfg_.forcer_max_v;
-      u_q_v_ = 0.0;
       v0_v_ = valid ? cfg_.pump_max_v : 0.0;
     } else {
-      u_a_v_ = 0.0;
       v0_v_ = agc_.update(w.a_A, dt_s);
+    }
+  }
+  // Forcers: direct drive at resonance along the pattern during ring-up (the
+  // pump alone cannot start a wave from zero amplitude), else quadrature
+  // nulling and the optional pattern command. Off: zero, loops hold.
+  u_a_v_ = u_q_v_ = u_r_v_ = 0.0;
+  if (forcers_on_) {
+    if (ring_up_) {
+      u_a_v_ = cfg_.forcer_max_v;
+    } else {
       u_q_v_ = quad_pi_.update(-w.a_B, dt_s);
     }
-    u_r_v_ = 0.0;
     if (pattern_enabled_ && valid) {
       const double w_rad_s = 2.0 * kPi * out_.pll_freq_hz;
-      const double rate =
-          clamp_abs(cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
-                    pattern_max_rate_rad_s_);
-      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2, cfg_.forcer_max_v);
+      const double rate = clamp_abs(
+          cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
+          pattern_max_rate_rad_s_);
+      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2,
+                         cfg_.forcer_max_v);
     }
   }
   out_.ring_up = ring_up_;
@@ -171,9 +176,8 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
 template <typename T>
 void Chain<T>::synthesize(uint32_t phase_block_start, std::span<q31_t> dac) const {
   const std::size_t n = cfg_.block_frames;
-  if (!excitation_) {
-    for (std::size_t j = 0; j < kChainDacChannels * n; ++j)
-      dac[j] = 0;
+  if (!pump_on_ && !forcers_on_) {
+    for (std::size_t j = 0; j < kChainDacChannels * n; ++j) dac[j] = 0;
     return;
   }
   const double inv_fs = 1.0 / cfg_.dac_full_scale_v;

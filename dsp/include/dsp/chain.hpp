@@ -119,8 +119,15 @@ class Chain {
 
   // Excitation off: every DAC word is exactly zero and the loops hold their
   // state (the PLL keeps tracking a ringing wave). On: ring-up or operation.
-  void set_excitation(bool on) { excitation_ = on; }
-  bool excitation() const { return excitation_; }
+  void set_excitation(bool on) { set_drive_enables(on, on); }
+  bool excitation() const { return pump_on_ || forcers_on_; }
+  // Finer gating (mode policy): the pump and the forcers separately. A drive
+  // that is off outputs exactly zero and the loop acting through it holds
+  // its state (AGC: pump; quadrature, pattern and ring-up: forcers).
+  void set_drive_enables(bool pump_on, bool forcers_on) {
+    pump_on_ = pump_on;
+    forcers_on_ = forcers_on;
+  }
 
   // Pattern-angle command: with `enabled`, the pattern is steered toward
   // theta_target_rad (unwrapped) at up to max_rate_rad_s; without it no
@@ -153,7 +160,8 @@ class Chain {
   ChainOutputs out_;
   uint32_t phase_ = 0;
   uint32_t step_ = 0;
-  bool excitation_ = false;
+  bool pump_on_ = false;
+  bool forcers_on_ = false;
   bool ring_up_ = true;
   bool pattern_enabled_ = false;
   double pattern_target_rad_ = 0.0;
