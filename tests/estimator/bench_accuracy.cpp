@@ -10,7 +10,9 @@
 // Prints the figures; exits non-zero if the compensated ADB misses 0.05 deg/h.
 #include <estimator/estimator.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 
@@ -53,7 +55,11 @@ double adb_error_deg_h(const ParamVector& est, const ParamVector& truth, double 
 }
 }  // namespace
 
-int main() {
+struct HourResult {
+  double raw_adb_deg_h, comp_adb_deg_h, converged_at_s, self_converged_at_s;
+};
+
+HourResult run_hour(uint64_t seed, bool verbose) {
   const sim::ResonatorParams rp;
   const ParamVector truth = truth_of(rp);
   const double K = rp.angular_gain;
@@ -68,7 +74,7 @@ int main() {
   Estimator::Config cfg;
   cfg.angular_gain = K;
   Estimator est{cfg};
-  std::mt19937_64 rng(2024);
+  std::mt19937_64 rng(seed);
 
   double off_time_s = 0;
   double converged_at_s = -1, self_converged_at_s = -1, first_accept_s = -1;
@@ -124,6 +130,8 @@ int main() {
   const Fit fc = fit_adb(th, comp, kParked);
   const Solution& s = est.last_solution();
   const ParamMatrix crb = est.cramer_rao_bound(kQuadratureNoiseV);
+  const HourResult result{fr.amplitude, fc.amplitude, converged_at_s, self_converged_at_s};
+  if (!verbose) return result;
 
   std::printf(
       "\nEstimator accuracy, 1 h on the averaged model (f 5 kHz, Q 5e6, dQ/Q 0.1, "
@@ -149,5 +157,25 @@ int main() {
   }
   std::printf("  residual noise sigma_hat %.3e V (injected %.3e V)\n", s.sigma_hat_v,
               kQuadratureNoiseV);
-  return fc.amplitude <= kGoalDegH ? 0 : 1;
+  return result;
+}
+
+int main() {
+  const HourResult main_run = run_hour(2024, true);
+  // The same hour with other noise seeds: the spread of the result.
+  constexpr int kSeeds = 20;
+  double worst = 0, sum = 0, conv_worst = 0;
+  int met = 0;
+  for (int i = 0; i < kSeeds; ++i) {
+    const HourResult r = run_hour(100 + i, false);
+    worst = std::max(worst, r.comp_adb_deg_h);
+    sum += r.comp_adb_deg_h;
+    met += r.comp_adb_deg_h <= kGoalDegH ? 1 : 0;
+    conv_worst = std::max(conv_worst, r.converged_at_s < 0 ? kHourS : r.converged_at_s);
+  }
+  std::printf(
+      "  over %d more noise seeds: compensated ADB mean %.4f, max %.4f deg/h; %d/%d meet "
+      "%.2f deg/h; latest convergence %.0f s\n",
+      kSeeds, sum / kSeeds, worst, met, kSeeds, kGoalDegH, conv_worst);
+  return main_run.comp_adb_deg_h <= kGoalDegH ? 0 : 1;
 }
