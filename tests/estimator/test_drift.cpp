@@ -137,3 +137,68 @@ TEST(ControlDrift, EstimatorFacadeAddsDPhiOnlyWithExcitationOn) {
   const double th = est.least_covered_theta_rad();
   CHECK(th >= 0 && th < M_PI / 2);
 }
+
+TEST(ControlDrift, EstimatorCompensatesDPhiWithExcitationOnOnly) {
+  // GIVEN an estimator with an accepted model (16 noise-free windows)
+  const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  SyntheticDecay gen{p, 0.554, 0.0};
+  Estimator::Config cfg;
+  Estimator est{cfg};
+  std::mt19937_64 rng(1);
+  for (int k = 0; k < 16; ++k) {
+    DecayState s{10.0 * k, 1.0, 0.0, 0.05 + k * M_PI / 32};
+    est.begin_window(s.t_s);
+    for (int i = 0; i < 1000; ++i) {
+      gen.step(s, 1e-3);
+      est.add_sample(gen.measure(s, 0.0, rng));
+    }
+    CHECK(est.end_window() == Status::ok);
+  }
+  CHECK(est.solve_and_accept().accepted());
+  CHECK(est.has_model());
+  // AND the loops show a constant D_Phi: a quadrature forcer with an
+  // out-of-phase part qc at a_A = 1, a_B = 0 gives D_Phi = -qc
+  const double qc = 2e-6, th = 0.3;
+  const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
+  const double g = p(kDwC) * s4 - p(kDwS) * c4;
+  for (int i = 0; i < 3000; ++i) {
+    // in-phase forcer part cancels the split's quadrature growth: a_B stays 0
+    est.add_control_sample({200.0 + i * 1e-3, 1.0, 0.0, th, 0.0, -g, qc});
+  }
+  DOUBLES_EQUAL(-qc, est.d_phi_rad_s(), 1e-3 * qc);
+  // WHEN the output is stepped for 1 s with and without excitation
+  const double dnu_rate = est.drift_rate_rad_s(th, 0.0) / 0.554;
+  const double c0 = est.correction_rad();
+  for (int i = 0; i < 1000; ++i)
+    est.step_output(th, 0.0, 1e-3, true);
+  const double with_exc = est.correction_rad() - c0;
+  for (int i = 0; i < 1000; ++i)
+    est.step_output(th, 0.0, 1e-3, false);
+  const double without = est.correction_rad() - c0 - with_exc;
+  // THEN D_Phi/K adds to the resonator drift only while the excitation is on
+  DOUBLES_EQUAL((dnu_rate - qc / 0.554) * 1.0, with_exc, 1e-3 * qc);
+  DOUBLES_EQUAL(dnu_rate * 1.0, without, 1e-3 * qc + 0.5e-3 * qc / 0.554);
+}
+
+TEST(ControlDrift, EstimatorKeepsNoModelFromIllConditionedWindows) {
+  const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  SyntheticDecay gen{p, 0.554, 0.0};
+  Estimator::Config cfg;
+  Estimator est{cfg};
+  std::mt19937_64 rng(1);
+  for (int k = 0; k < 16; ++k) {
+    DecayState s{10.0 * k, 1.0, 0.0, 0.3};
+    est.begin_window(s.t_s);
+    for (int i = 0; i < 1000; ++i) {
+      gen.step(s, 1e-3);
+      est.add_sample(gen.measure(s, 2e-5, rng));
+    }
+    est.end_window();
+  }
+  CHECK(est.solve_and_accept().status == Status::ill_conditioned);
+  CHECK_FALSE(est.has_model());
+  DOUBLES_EQUAL(0.0, est.drift_rate_rad_s(0.3, 0.0), 0.0);
+  CHECK(est.conditioning().kappa_2 > cfg.ls.max_kappa_2);
+  // the scheduler is pointed away from the one covered bin
+  CHECK(coverage_bin(est.least_covered_theta_rad()) != coverage_bin(0.3));
+}
