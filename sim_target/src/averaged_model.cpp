@@ -92,12 +92,30 @@ AveragedModel::AveragedModel(const ResonatorParams& params, const ElectrodeParam
   r_(4) = 1.0;
 }
 
-void AveragedModel::set_params(const ResonatorParams& p) { params_ = p; }
-void AveragedModel::set_electrodes(const ElectrodeParams& e) { electrodes_ = e; }
-void AveragedModel::set_effects(const Effects& fx) { effects_ = fx; }
-void AveragedModel::set_rate_profile(Profile rate_rad_s) { rate_ = std::move(rate_rad_s); }
-void AveragedModel::set_temperature_profile(Profile temp_c) { temp_ = std::move(temp_c); }
-void AveragedModel::set_drive(const EnvelopeDrive& drive) { drive_ = drive; }
+void AveragedModel::set_params(const ResonatorParams& p) {
+  params_ = p;
+  dirty_ = true;
+}
+void AveragedModel::set_electrodes(const ElectrodeParams& e) {
+  electrodes_ = e;
+  dirty_ = true;
+}
+void AveragedModel::set_effects(const Effects& fx) {
+  effects_ = fx;
+  dirty_ = true;
+}
+void AveragedModel::set_rate_profile(Profile rate_rad_s) {
+  rate_ = std::move(rate_rad_s);
+  dirty_ = true;
+}
+void AveragedModel::set_temperature_profile(Profile temp_c) {
+  temp_ = std::move(temp_c);
+  dirty_ = true;
+}
+void AveragedModel::set_drive(const EnvelopeDrive& drive) {
+  drive_ = drive;
+  dirty_ = true;
+}
 
 void AveragedModel::set_standing_wave(double a_a_v, double theta_rad, double a_b_v,
                                       double phase_rad) {
@@ -201,12 +219,16 @@ void AveragedModel::advance(double dt_s) {
       const Vec5 r_mid = detail::expm<Mat5>(a0 * (0.5 * h)) * r_;
       const Mat5 a_mid = system_matrix(t_s_ + 0.5 * h, r_mid);
       r_ = detail::expm<Mat5>(a_mid * h) * r_;
+    } else if (!time_dep && !dirty_ && h == cached_h_) {
+      r_ = cached_phi_ * r_;  // constant system, same step: the cached propagator is exact
     } else {
       const Mat5 ah = system_matrix(t_s_ + 0.5 * h, r_) * h;
       if (ah != cached_ah_) {
         cached_ah_ = ah;
         cached_phi_ = detail::expm<Mat5>(ah);
       }
+      cached_h_ = h;
+      dirty_ = false;
       r_ = cached_phi_ * r_;
     }
     r_(4) = 1.0;

@@ -152,6 +152,8 @@ class AveragedModel {
   Vec5 r_ = Vec5::Zero();
   Mat5 cached_ah_ = Mat5::Zero();
   Mat5 cached_phi_ = Mat5::Identity();
+  double cached_h_ = -1.0;
+  bool dirty_ = true;  // a setter changed the system since cached_phi_ was built
 };
 
 }  // namespace hrg::sim
