@@ -104,6 +104,9 @@ TEST(CandumpLog, MalformedLinesAreRefusedWithTheReason) {
       {"(1.0) can0 40000100#00", "flag bits"},
       {"(1.x) can0 100#00", "fraction"},
       {"(1.0)", "expected"},
+      {"(1.0) can\x01 100#00", "non-printable"},
+      {"(1.0) an-interface-name-too-long 100#00", "longer than 15"},
+      {"(18446744073.0) can0 100#00", "beyond"},
   };
   for (const auto& b : bad) {
     LoggedFrame lf;

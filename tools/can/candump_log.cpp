@@ -51,6 +51,11 @@ bool parse_timestamp(std::string_view s, uint64_t& t_ns, std::string& error) {
     frac_ns += static_cast<uint64_t>(s[i] - '0') * scale;
     scale /= 10;
   }
+  // 18446744072 s is the last whole second representable in uint64 nanoseconds.
+  if (sec >= 18'446'744'073ull) {
+    error = "timestamp beyond year 2554";
+    return false;
+  }
   t_ns = sec * 1'000'000'000ull + frac_ns;
   return true;
 }
@@ -179,7 +184,19 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& er
     return false;
   }
   if (!parse_timestamp(line.substr(0, sp1), out.t_ns, error)) return false;
-  out.interface = std::string(line.substr(sp1 + 1, sp2 - sp1 - 1));
+  const std::string_view iface = line.substr(sp1 + 1, sp2 - sp1 - 1);
+  // Linux interface names: at most 15 printable characters (IFNAMSIZ - 1).
+  if (iface.size() > 15) {
+    error = "interface name longer than 15 characters";
+    return false;
+  }
+  for (char c : iface) {
+    if (c <= ' ' || c > '~') {
+      error = "interface name has a non-printable character";
+      return false;
+    }
+  }
+  out.interface = std::string(iface);
   std::string_view rest = line.substr(sp2 + 1);
   // candump -l may append a direction/flags field (" T", " R"); ignore it.
   const auto sp3 = rest.find(' ');

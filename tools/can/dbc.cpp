@@ -87,9 +87,13 @@ void parse_signal(Tokens& t, DbcMessage& m) {
   std::string tok = t.next();
   if (tok != ":") t.fail("multiplexed signal '" + s.name + "' is not supported");
   // "0|24@1-": start, '|', length, '@', then byte order and sign as one word.
-  s.start_bit = static_cast<unsigned>(t.integer());
+  const uint64_t start = t.integer();
   t.expect("|");
-  s.length = static_cast<unsigned>(t.integer());
+  const uint64_t length = t.integer();
+  if (start > 63 || length == 0 || length > 64 || start + length > 64)
+    t.fail("signal '" + s.name + "' does not fit in 8 bytes");
+  s.start_bit = static_cast<unsigned>(start);
+  s.length = static_cast<unsigned>(length);
   t.expect("@");
   const std::string order_sign = t.next();
   if (order_sign.size() != 2 || (order_sign[1] != '+' && order_sign[1] != '-'))
@@ -108,8 +112,6 @@ void parse_signal(Tokens& t, DbcMessage& m) {
   s.max = t.number();
   t.expect("]");
   s.unit = t.next();
-  if (s.length == 0 || s.length > 64 || s.start_bit + s.length > 64)
-    t.fail("signal '" + s.name + "' does not fit in 8 bytes");
   if (s.factor == 0) t.fail("signal '" + s.name + "' has a zero factor");
   m.signals.push_back(std::move(s));
 }
