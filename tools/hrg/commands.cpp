@@ -7,10 +7,13 @@
 
 namespace hrg::cli {
 
+int scenario_check_main(std::span<char* const> args);  // scenario_check_command.cpp
+
 namespace {
-constexpr std::array<Command, 1> kCommands{{
+constexpr std::array<Command, 2> kCommands{{
     {"audit", "locate sim/recording mismatches and name the left-out physics",
      &hrg::audit::audit_main},
+    {"scenario-check", "validate simulator scenario files (TOML)", &scenario_check_main},
 }};
 }  // namespace
 
