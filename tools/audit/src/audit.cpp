@@ -21,6 +21,10 @@ namespace {
 using namespace detail;
 constexpr double kPi = std::numbers::pi;
 constexpr double kRadToDeg = 180.0 / kPi;
+// Detection threshold of an effect: the strength that stands this many
+// standard deviations of its own estimate above zero (and never below the
+// strength at which its delta BIC turns positive).
+constexpr double kDetectionSigmas = 5.0;
 
 // Model parameter of each effect (-1: the edge statistic instead).
 int param_of(Effect e) {
@@ -296,7 +300,8 @@ AuditResult Auditor::run(PlotData* plot) {
         if (first_step) {
           ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
           out.candidates.push_back({e, true, std::max(ft.c_x, ft.c_y), ft.sigma,
-                                    ft.dchi2 - 4.0 * ln_neff(cur), ft.threshold});
+                                    ft.dchi2 - 4.0 * ln_neff(cur),
+                                    std::max(ft.threshold, kDetectionSigmas * ft.sigma)});
         }
         continue;
       }
@@ -309,8 +314,8 @@ AuditResult Auditor::run(PlotData* plot) {
                        to_catalogue(e, s.fit.sigma[pi]) / std::sqrt(s.kappa)});
       if (first_step) {
         const double sig = std::abs(to_catalogue(e, s.fit.sigma[pi])) / std::sqrt(s.kappa);
-        out.candidates.push_back(
-            {e, true, to_catalogue(e, s.fit.p[pi]), sig, dbic, sig * std::sqrt(ln_neff(s))});
+        out.candidates.push_back({e, true, to_catalogue(e, s.fit.p[pi]), sig, dbic,
+                                  sig * std::max(kDetectionSigmas, std::sqrt(ln_neff(s)))});
       }
     }
     first_step = false;

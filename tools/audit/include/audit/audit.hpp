@@ -81,8 +81,9 @@ struct CandidateScore {
   double value = 0.0;
   double sigma = 0.0;  // Cramer-Rao-like 1-sigma from the fit (effective samples)
   double delta_bic = 0.0;
-  // Strength at which the expected delta BIC of this effect alone is zero
-  // (the detection threshold of this recording's design and noise).
+  // Detection threshold of this recording's design and noise: 5 sigma of the
+  // effect's own estimate, or the strength at which its expected delta BIC
+  // turns positive if that is larger.
   double threshold = 0.0;
 };
 

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "audit/audit.hpp"
+
+// The proof of `hrg audit`: recordings from sim_target with one catalogue
+// effect concealed at a random sign and a strength of 0.3x-3x its detection
+// threshold, and null recordings, in ring-down and telemetry campaigns.
+namespace hrg::audit {
+
+struct BenchOptions {
+  int designs = 10;  // random resonators/campaigns; each gives 1 null + 1 per effect
+  uint64_t seed = 1;
+  double ringdown_s = 480.0;
+  double telemetry_s = 360.0;
+  bool verbose = false;
+};
+
+struct BenchCase {
+  int design = 0;
+  bool telemetry = false;
+  int truth = -1;           // Effect index, -1 = null
+  double strength = 0.0;    // multiple of the detection threshold
+  double true_value = 0.0;  // catalogue parameter
+  int top = -1;             // top finding's Effect index, -1 = none
+  double top_value = 0.0;
+  std::string verdict;
+  double seconds = 0.0;
+};
+
+struct BenchResult {
+  std::vector<BenchCase> cases;
+  // Rows: true effect (0..8) then null (9); columns: top finding (0..8), none (9).
+  std::array<std::array<int, kEffectCount + 1>, kEffectCount + 1> confusion{};
+  int above2x = 0, above2x_hits = 0;  // hit = top finding right and parameter within 20 %
+  int nulls = 0, null_findings = 0;
+  int below1x = 0, below1x_found = 0;
+  double mean_audit_s = 0.0;
+};
+
+BenchResult run_benchmark(const BenchOptions& o);
+std::string format_benchmark(const BenchResult& r);
+
+}  // namespace hrg::audit

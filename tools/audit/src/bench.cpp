@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: MIT
+#include "audit/bench.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "campaign.hpp"
+
+namespace hrg::audit {
+
+namespace {
+
+using bench::Design;
+using bench::Scenario;
+
+// Conceals effect `e` with catalogue value `v` in the scenario.
+void conceal(Scenario& s, Effect e, double v, std::mt19937_64& g) {
+  auto& fx = s.effects;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  switch (e) {
+    case Effect::pickoff_gain_mismatch: fx.pickoff_gain_mismatch = {true, v}; break;
+    case Effect::pickoff_phase_mismatch: fx.pickoff_phase_mismatch = {true, v}; break;
+    case Effect::pickoff_misalignment: fx.pickoff_misalignment = {true, v}; break;
+    case Effect::duffing_stiffness: fx.duffing_stiffness = {true, v}; break;
+    case Effect::nonlinear_damping: fx.nonlinear_damping = {true, v}; break;
+    case Effect::thermal_frequency: fx.thermal_frequency = {true, v}; break;
+    case Effect::thermal_damping: fx.thermal_damping = {true, v}; break;
+    case Effect::electrostatic_spring: fx.electrostatic_spring = {true, v}; break;
+    case Effect::drive_feedthrough: {
+      const double big = std::abs(v), small = big * u(g);
+      const bool x_big = u(g) < 0.5;
+      fx.drive_feedthrough.enabled = true;
+      fx.drive_feedthrough.x_v_per_v = x_big ? big : small;
+      fx.drive_feedthrough.y_v_per_v = x_big ? small : big;
+      fx.drive_feedthrough.x_phase_deg = 360.0 * u(g);
+      fx.drive_feedthrough.y_phase_deg = 360.0 * u(g);
+      break;
+    }
+  }
+}
+
+int top_of(const AuditResult& r, double& value) {
+  if (r.findings.empty()) return -1;
+  value = r.findings.front().value;
+  return static_cast<int>(r.findings.front().effect);
+}
+
+}  // namespace
+
+BenchResult run_benchmark(const BenchOptions& o) {
+  BenchResult res;
+  double audit_s = 0.0;
+  int audits = 0;
+  auto timed_audit = [&](const recording::Recording& rec) {
+    const auto t0 = std::chrono::steady_clock::now();
+    AuditResult r = run_audit(rec);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    audit_s += s;
+    ++audits;
+    return std::make_pair(r, s);
+  };
+  for (int d = 0; d < o.designs; ++d) {
+    const bool tele = d % 2 == 1;
+    const uint64_t seed = o.seed * 100003ULL + static_cast<uint64_t>(d);
+    const Scenario base = bench::random_scenario(tele ? Design::telemetry : Design::ringdown,
+                                                 tele ? o.telemetry_s : o.ringdown_s, seed);
+    // Null twin: the same resonator, campaign and noise with nothing concealed.
+    const auto [null_r, null_s] = timed_audit(bench::simulate(base));
+    BenchCase nc;
+    nc.design = d;
+    nc.telemetry = tele;
+    nc.top = top_of(null_r, nc.top_value);
+    nc.verdict = null_r.verdict;
+    nc.seconds = null_s;
+    res.cases.push_back(nc);
+    ++res.nulls;
+    if (nc.top >= 0) ++res.null_findings;
+    res.confusion[kEffectCount][nc.top >= 0 ? static_cast<std::size_t>(nc.top) : kEffectCount]++;
+    if (o.verbose) {
+      std::fprintf(stderr, "design %d (%s) null: %s\n", d, tele ? "telemetry" : "ring-down",
+                   null_r.verdict.c_str());
+    }
+    std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (const auto& cand : null_r.candidates) {
+      if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
+      BenchCase c;
+      c.design = d;
+      c.telemetry = tele;
+      c.truth = static_cast<int>(cand.effect);
+      c.strength = 0.3 + 2.7 * u(g);
+      const double sign = u(g) < 0.5 ? -1.0 : 1.0;
+      c.true_value = sign * c.strength * cand.threshold;
+      if (cand.effect == Effect::drive_feedthrough) c.true_value = std::abs(c.true_value);
+      Scenario s = base;
+      conceal(s, cand.effect, c.true_value, g);
+      const auto [r, secs] = timed_audit(bench::simulate(s));
+      c.top = top_of(r, c.top_value);
+      c.verdict = r.verdict;
+      c.seconds = secs;
+      res.confusion[static_cast<std::size_t>(c.truth)]
+                   [c.top >= 0 ? static_cast<std::size_t>(c.top) : kEffectCount]++;
+      const bool right = c.top == c.truth;
+      const bool close = std::abs(c.top_value - c.true_value) <= 0.2 * std::abs(c.true_value);
+      if (c.strength >= 2.0) {
+        ++res.above2x;
+        if (right && close) ++res.above2x_hits;
+      }
+      if (c.strength < 1.0) {
+        ++res.below1x;
+        if (right) ++res.below1x_found;
+      }
+      if (o.verbose) {
+        std::fprintf(stderr, "  %-24s x%.2f true %.4g -> %s %s %.4g%s\n",
+                     effect_info(cand.effect).id, c.strength, c.true_value, r.verdict.c_str(),
+                     c.top >= 0 ? effect_info(static_cast<Effect>(c.top)).id : "-", c.top_value,
+                     c.strength >= 2.0 && !(right && close) ? "   <-- MISS" : "");
+      }
+      res.cases.push_back(c);
+    }
+  }
+  res.mean_audit_s = audits ? audit_s / audits : 0.0;
+  return res;
+}
+
+std::string format_benchmark(const BenchResult& r) {
+  std::string o;
+  char buf[512];
+  static const char* kShort[kEffectCount + 1] = {"gain",   "phase",  "misal",  "duff",   "nldamp",
+                                                 "thfreq", "thdamp", "spring", "feedth", "none"};
+  o += "Confusion matrix (rows: concealed effect, columns: top finding)\n";
+  o += std::string(26, ' ');
+  for (const char* s : kShort) {
+    std::snprintf(buf, sizeof buf, "%7s", s);
+    o += buf;
+  }
+  o += "\n";
+  for (std::size_t i = 0; i <= kEffectCount; ++i) {
+    std::snprintf(
+        buf, sizeof buf, "%-26s",
+        i < kEffectCount ? effect_info(static_cast<Effect>(i)).id : "(nothing concealed)");
+    o += buf;
+    for (std::size_t j = 0; j <= kEffectCount; ++j) {
+      std::snprintf(buf, sizeof buf, "%7d", r.confusion[i][j]);
+      o += buf;
+    }
+    o += "\n";
+  }
+  std::snprintf(buf, sizeof buf,
+                "\nHit rate above 2x threshold (top finding right, parameter within 20 %%): "
+                "%d/%d = %.1f %% (goal >= 95 %%)\n",
+                r.above2x_hits, r.above2x, r.above2x ? 100.0 * r.above2x_hits / r.above2x : 0.0);
+  o += buf;
+  std::snprintf(buf, sizeof buf,
+                "False-finding rate on null recordings: %d/%d = %.1f %% (goal <= 5 %%)\n",
+                r.null_findings, r.nulls, r.nulls ? 100.0 * r.null_findings / r.nulls : 0.0);
+  o += buf;
+  std::snprintf(buf, sizeof buf, "Found below 1x threshold (for reference): %d/%d\n",
+                r.below1x_found, r.below1x);
+  o += buf;
+  // Confusable pairs of the catalogue.
+  struct Pair {
+    Effect a, b;
+  };
+  const Pair pairs[] = {{Effect::duffing_stiffness, Effect::thermal_frequency},
+                        {Effect::duffing_stiffness, Effect::electrostatic_spring},
+                        {Effect::thermal_frequency, Effect::electrostatic_spring},
+                        {Effect::nonlinear_damping, Effect::thermal_damping},
+                        {Effect::pickoff_phase_mismatch, Effect::pickoff_misalignment},
+                        {Effect::pickoff_gain_mismatch, Effect::pickoff_misalignment}};
+  o += "\nConfusable pairs (cases of one taken for the other, all strengths):\n";
+  for (const auto& p : pairs) {
+    const auto ia = static_cast<std::size_t>(p.a), ib = static_cast<std::size_t>(p.b);
+    int na = 0, nb = 0;
+    for (std::size_t j = 0; j <= kEffectCount; ++j)
+      na += r.confusion[ia][j], nb += r.confusion[ib][j];
+    std::snprintf(buf, sizeof buf, "  %-22s <-> %-22s  %d/%d and %d/%d\n", effect_info(p.a).id,
+                  effect_info(p.b).id, r.confusion[ia][ib], na, r.confusion[ib][ia], nb);
+    o += buf;
+  }
+  // Against the baseline's own parameters: a miss above 2x means the
+  // baseline (damping anisotropy, split) absorbed the effect.
+  o += "Against the baseline (effect above 2x threshold absorbed, no finding):\n";
+  for (Effect e : {Effect::pickoff_gain_mismatch, Effect::pickoff_phase_mismatch,
+                   Effect::pickoff_misalignment}) {
+    int n = 0, miss = 0;
+    for (const auto& c : r.cases) {
+      if (c.truth == static_cast<int>(e) && c.strength >= 2.0) {
+        ++n;
+        if (c.top < 0) ++miss;
+      }
+    }
+    std::snprintf(buf, sizeof buf, "  %-22s vs %s: %d/%d\n", effect_info(e).id,
+                  e == Effect::pickoff_gain_mismatch ? "damping anisotropy" : "frequency split",
+                  miss, n);
+    o += buf;
+  }
+  std::snprintf(buf, sizeof buf, "\nMean audit time per recording: %.2f s\n", r.mean_audit_s);
+  o += buf;
+  return o;
+}
+
+}  // namespace hrg::audit

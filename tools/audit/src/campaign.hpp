@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Synthetic campaigns for the audit benchmark: sim_target's averaged model
+// driven by a simple envelope controller, recorded as hrg-recording v1 with
+// white noise on the demodulated signals.
+//  - ring-down: a few seconds of excitation (amplitude to its set point, the
+//    pump nulls the quadrature, forcers move the pattern to a new angle), then
+//    a free decay of 10-30 s, some under a turning rate table, one long decay;
+//  - telemetry: the firmware's interval shutdown, excitation for 4-10 s with
+//    the pattern free under a stepped rate, short free windows of 0.4-2 s.
+
+#include <cstdint>
+#include <random>
+
+#include "recording/recording.hpp"
+#include "sim_target/params.hpp"
+
+namespace hrg::audit::bench {
+
+enum class Design { ringdown, telemetry };
+
+struct Scenario {
+  Design design = Design::ringdown;
+  sim::ResonatorParams resonator;
+  sim::ElectrodeParams electrodes;
+  sim::Effects effects;
+  double f_ref_hz = 5000.0;
+  double amplitude_v = 1.0;  // set point of the excitation
+  double noise_v = 1e-5;     // white noise per demodulated signal
+  double duration_s = 600.0;
+  double sample_rate_hz = 200.0;
+  double temp_mean_c = 25.0, temp_swing_c = 1.0;  // slow temperature swing
+  uint64_t seed = 1;
+};
+
+// A random resonator, noise and campaign of the given design (effects off).
+Scenario random_scenario(Design design, double duration_s, uint64_t seed);
+
+// Simulates the campaign and returns the recording (deterministic in seed).
+recording::Recording simulate(const Scenario& s);
+
+}  // namespace hrg::audit::bench
