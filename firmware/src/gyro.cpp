@@ -12,6 +12,7 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
       chain_(chain),
       identifier_(identifier),
       cfg_(cfg),
+      exec_timer_(timer),
       exec_(kGyroTasks, kBaseRateHz, board.clock, timer, pacing),
       monitor_(cfg.monitor),
       scheduler_(cfg.windows),
@@ -37,7 +38,9 @@ void Gyro::release_pattern() { host_pattern_ = false; }
 void Gyro::task_chain(Gyro& g) {
   uint64_t t_first_ns = 0;
   uint32_t clipped = 0;
+  const uint64_t t_wait = g.exec_timer_.now_ns();
   const hal::Status st = g.board_.adc.read_block(g.adc_, t_first_ns, clipped);
+  g.status_.adc_wait_ns += g.exec_timer_.now_ns() - t_wait;
   if (st != hal::Status::ok) {
     ++g.status_.adc_errors;
     return;
@@ -132,7 +135,9 @@ void Gyro::task_supervise(Gyro& g) {
   in.adc_clipped = g.adc_clipped_;
   in.adc_samples = static_cast<uint32_t>(g.adc_.size());
   in.adc_stuck = g.adc_stuck_;
-  in.recent_overruns = g.exec_.recent_overrun_frames();
+  // In lockstep the task times are host times, not the target's: they are
+  // reported, but a busy host must not fault the simulated gyro.
+  in.recent_overruns = g.exec_.pacing() == Pacing::real_time ? g.exec_.recent_overrun_frames() : 0;
   in.external_fault = fault_in;
   in.dac_error = g.dac_error_;
   const uint16_t faults = g.monitor_.update(in, g.mode_.mode());
@@ -187,8 +192,13 @@ void Gyro::task_output(Gyro& g) {
   const bool moving_on_purpose = g.status_.pattern_control;
   if (moving_on_purpose) g.output_.rereference();
   const double ratio = o.a_a_v > 0.0 ? o.a_b_v / o.a_a_v : 0.0;
-  const double drift =
-      g.cfg_.compensate_drift ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio) : 0.0;
+  // The model is applied once the campaign has ended (conditioning and
+  // coverage good): an early solution from a few windows at nearby angles
+  // would add more error than it removes.
+  if (g.scheduler_.campaign_done()) g.compensation_ready_ = true;
+  const double drift = g.cfg_.compensate_drift && g.compensation_ready_
+                           ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio)
+                           : 0.0;
   const bool valid = g.mode_.permissions().output_valid && !moving_on_purpose;
   g.output_.update(o.theta_a_rad, drift, valid);
   GyroStatus& s = g.status_;

@@ -70,7 +70,8 @@ WindowDecision ShutdownScheduler::step(Mode mode, double theta_rad, double theta
     }
     return d;
   }
-  const bool estimator_good = health.solved && health.condition > 0 &&
+  const bool estimator_good = counts_[least_covered_bin()] >= cfg_.min_windows_per_bin &&
+                              health.solved && health.condition > 0 &&
                               health.condition <= cfg_.condition_good &&
                               health.coverage >= cfg_.coverage_good;
   // The per-bin cap bounds the excitation-off time when the estimator never

@@ -190,13 +190,26 @@ TEST(Gyro, AnOverrunStormIsAFault) {
   } timer2;
   auto cfg = test_config();
   cfg.identify = false;
-  Gyro g(b.board, chain, ident, timer2, Pacing::lockstep, cfg);
+  // (real-time pacing: in lockstep host overruns are not a fault, see below)
+  b.clock.set_lockstep(false);
+  Gyro g(b.board, chain, ident, timer2, Pacing::real_time, cfg);
   CHECK(run_until(g, Mode::operate) > 0);
   timer2.slow = true;
   // 16 overrun frames out of the last 64 make a storm; the monitor sees a
   // frame's overruns in the next frame, so the 17th frame raises it
   LONGS_EQUAL(17, run_until(g, Mode::fault, 100));
   CHECK(g.mode_machine().faults() & fault_bit(Fault::overrun_storm));
+}
+
+TEST(Gyro, InLockstepHostOverrunsAreCountedButAreNotAFault) {
+  struct SlowTimer final : hrg::hal::MonotonicClock {
+    mutable uint64_t t = 0;
+    uint64_t now_ns() const override { return t += 1'000'000; }
+    hrg::hal::Status sleep_until_ns(uint64_t) override { return hrg::hal::Status::ok; }
+  } slow;
+  Gyro g(b.board, chain, ident, slow, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::operate) > 0);
+  CHECK(g.executive().task_stats()[0].overruns > 100);
 }
 
 TEST(Gyro, SkippedAdcBlocksAreCounted) {

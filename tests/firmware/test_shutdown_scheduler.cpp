@@ -164,3 +164,20 @@ TEST(ShutdownScheduler, FillsAllBinsEvenlyOnASweep) {
   LONGS_EQUAL(3, lo);
   CHECK(hi - lo <= 1);
 }
+
+TEST(ShutdownScheduler, TheEstimatorsWordCountsOnlyOnceEveryBinHasItsMinimum) {
+  auto c = small_config();
+  c.min_windows_per_bin = 1;
+  c.windows_per_bin = 100;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  // GIVEN a good estimator from the start, theta sweeping
+  int f = 0;
+  for (; f < 100'000 && !l.s.campaign_done(); ++f)
+    l.frame(1e-3 * f, 1.0, good);
+  // THEN the campaign ends exactly when the last bin gets its first window
+  CHECK(l.s.campaign_done());
+  for (uint32_t b = 0; b < 8; ++b)
+    CHECK(l.s.bin_count(b) >= 1);
+  LONGS_EQUAL(8, l.s.windows());
+}

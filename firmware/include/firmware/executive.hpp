@@ -97,12 +97,18 @@ class Executive {
   void run_frame(Ctx& ctx) {
     if (!started_) start(pace_.now_ns());
     pace_frame();
-    const uint64_t frame_start = timer_.now_ns();
+    uint64_t frame_start = 0;
+    bool first = true;
     uint64_t slot_ns = 0;  // where the next task's slot begins, relative to frame start
     bool any_overrun = false;
     for (std::size_t i = 0; i < N; ++i) {
       if (tick_ % divider_[i] != 0) continue;
       const uint64_t t_start = timer_.now_ns();
+      if (first) {
+        // The frame starts with its first task: that task cannot slip.
+        frame_start = t_start;
+        first = false;
+      }
       tasks_[i].run(ctx);
       const uint64_t t_end = timer_.now_ns();
       auto& s = stats_[i];
@@ -118,7 +124,7 @@ class Executive {
       if (t_start - frame_start > slot_ns) ++s.slips;
       slot_ns += tasks_[i].budget_ns;
     }
-    const uint32_t frame_ns = clamp_u32(timer_.now_ns() - frame_start);
+    const uint32_t frame_ns = first ? 0 : clamp_u32(timer_.now_ns() - frame_start);
     if (frame_ns > frame_.max_frame_ns) frame_.max_frame_ns = frame_ns;
     overrun_history_ = (overrun_history_ << 1) | (any_overrun ? 1u : 0u);
     ++frame_.frames;

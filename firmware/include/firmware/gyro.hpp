@@ -49,6 +49,7 @@ struct GyroStatus {
   uint32_t adc_errors = 0;
   uint32_t adc_missed_blocks = 0;
   uint32_t dac_errors = 0;
+  uint64_t adc_wait_ns = 0;  // timer time spent in Adc::read_block (lockstep: the simulation)
 };
 
 // The firmware: wires the HAL board, the signal chain and the identifier to
@@ -104,6 +105,7 @@ class Gyro {
   SignalChain& chain_;
   Identifier& identifier_;
   GyroConfig cfg_;
+  hal::MonotonicClock& exec_timer_;
   Executive<Gyro, kTaskCount> exec_;
   ModeMachine mode_;
   FaultMonitor monitor_;
@@ -123,6 +125,7 @@ class Gyro {
   bool adc_stuck_ = false;
   bool dac_error_ = false;
   bool host_pattern_ = false;
+  bool compensation_ready_ = false;
   double host_pattern_target_rad_ = 0.0;
   bool enable_written_ = false;
   bool board_ok_ = true;

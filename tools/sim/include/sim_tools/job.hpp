@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dsp/chain.hpp"
+#include "estimator/estimator.hpp"
+#include "firmware/gyro.hpp"
+#include "sim_target/sim_config.hpp"
+#include "sim_tools/analysis.hpp"
+
+namespace hrg::simtools {
+
+// One parked interval of the angle-dependent-bias test: the case is still,
+// the pattern sits at one angle, and the bias is the slope of the angle error.
+struct Park {
+  double t_begin_s = 0.0;  // measurement starts (after the settle time)
+  double t_end_s = 0.0;
+};
+
+// Everything the main job needs: the simulated target, the firmware and its
+// parts, the input schedule and what to record.
+struct JobConfig {
+  sim::SimConfig sim;
+  fw::GyroConfig gyro;
+  dsp::ChainConfig chain;
+  est::Estimator::Config estimator;
+  double duration_s = 0.0;
+  double latitude_deg = 55.75;
+  double earth_rate_rad_s = 0.0;  // vertical component of the Earth rate in the input
+  double telemetry_hz = 100.0;    // rows of telemetry.csv per simulated second
+  double sweep_end_s = 0.0;       // end of the turning (identification) phase
+  std::vector<Park> parks;        // the bias test (empty: none)
+  std::string description;
+};
+
+// The default scenario: the seed's resonator (5 kHz, Q 5e6, dQ/Q 0.1, split
+// 5e-4 Hz), a 24-bit 100 kHz ADC with white noise, Earth rate at 55.75 deg N,
+// ring-up from rest, a rate-table sweep that turns the pattern twice through
+// the 4 theta circle, then the pattern parked at `bias_angles` angles on a
+// still base. `duration_s` <= 0 takes the default length; a longer duration
+// lengthens the parks; a shorter one drops the parks that do not fit.
+JobConfig default_job(double duration_s, int bias_angles = 16);
+
+// Fills the firmware-side configuration (chain converters, estimator K) from
+// the simulated board, so that a scenario only has to describe the target.
+void derive_firmware_config(JobConfig& job);
+
+// One telemetry row (the recording's columns plus the truth).
+struct Row {
+  double t_s, cx_v, sx_v, cy_v, sy_v;
+  int exc;
+  double pump_v, temp_c, rate_dps, f_ref_hz, quad_v;
+  int mode;
+  double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
+  double a_a_v, a_b_v, drift_model_dph, drift_true_dph;
+  int out_valid;
+};
+
+struct ParkResult {
+  double theta_rad = 0.0;       // mean pattern angle while parked
+  double bias_raw_dph = 0.0;    // slope of (raw output - true angle), input-rate units
+  double bias_comp_dph = 0.0;   // same with the drift compensation
+  double bias_model_dph = 0.0;  // the true D/K at that angle (what the model predicts)
+};
+
+struct TaskFigures {
+  std::string name;
+  uint32_t rate_hz = 0;
+  uint32_t budget_ns = 0;
+  uint32_t min_ns = 0;
+  uint32_t max_ns = 0;
+  double mean_ns = 0.0;
+  uint32_t overruns = 0;
+  uint32_t slips = 0;
+  uint64_t runs = 0;
+};
+
+struct JobResult {
+  bool reached_operate = false;
+  double t_operate_s = -1.0;  // first time in operate
+  fw::Mode final_mode = fw::Mode::power_up;
+  uint16_t faults_seen = 0;
+  double sim_s = 0.0;
+  double wall_s = 0.0;
+  double cpu_s = 0.0;                // process CPU time of the loop
+  double realtime_factor = 0.0;      // simulated s per wall s
+  double realtime_factor_cpu = 0.0;  // simulated s per CPU s (what one free core gives)
+  double sim_share = 0.0;            // share of the wall time spent in the simulated ADC (physics)
+  double excitation_off_fraction = 0.0;
+  uint32_t windows = 0;
+  uint32_t windows_accepted = 0;
+  bool campaign_done = false;
+  fw::Identification identification{};
+  std::array<double, 5> truth{};
+  double condition = 0.0;
+  double coverage = 0.0;
+  std::vector<Row> rows;
+  std::vector<ParkResult> parks;
+  BiasFit fit_raw, fit_comp, fit_model;
+  std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
+  double tracking_rms_deg = 0.0;  // compensated output - true, after operate
+  double tracking_max_deg = 0.0;
+  double raw_error_end_deg = 0.0;    // raw output - true at the end
+  double comp_error_end_deg = 0.0;   // compensated output - true at the end
+  double model_error_end_deg = 0.0;  // -integral of the true D/K over the valid output
+  double drift_bound_deg = 0.0;      // integral of |true D|/K: the drift model's bound
+  std::vector<TaskFigures> tasks;
+  fw::FrameStats frames{};
+  uint64_t can_frames = 0;
+  std::vector<std::string> failures;  // empty: the run passed
+};
+
+// Runs firmware + simulated target in lockstep. `progress` draws a bar on
+// stderr; `can_log` (when not empty) receives every CAN frame as a candump log.
+JobResult run_job(const JobConfig& job, bool progress, const std::string& can_log);
+
+// The true drift D (rad/s, Omega K units) of the resonator at pattern angle
+// theta with quadrature ratio a_B/a_A (physics.md section 3, D_nu + D_w).
+double true_drift_rad_s(const sim::ResonatorParams& p, double theta_rad, double ab_over_aa);
+
+// p = (nu, dnu_C, dnu_S, dw_C, dw_S) of the simulated resonator.
+std::array<double, 5> true_parameters(const sim::ResonatorParams& p);
+
+}  // namespace hrg::simtools

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "sim_tools/job.hpp"
+
+namespace hrg::simtools {
+
+// report.json: realtime_factor, excitation_off_fraction, drift.{raw,compensated}
+// .{adb_dph, mean_dph}, identification (estimate, sigma, truth per parameter),
+// executive (per task max time and overruns), checks.
+std::string report_json(const JobConfig& job, const JobResult& r);
+
+// telemetry.csv: hrg-recording v1 plus theta_deg, out_angle_deg,
+// true_angle_deg, mode and the truth columns.
+void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r);
+
+// bias.csv (one row per parked angle) and allan.csv (tau, adev) for the plots.
+void write_bias_csv(const std::filesystem::path& path, const JobResult& r);
+void write_allan_csv(const std::filesystem::path& path, const JobResult& r);
+
+// The end-of-run summary table.
+void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r);
+
+// Fills r.failures with what makes the run a failure (see the checks in
+// report_json); returns true when the run passed.
+bool judge(const JobConfig& job, JobResult& r);
+
+}  // namespace hrg::simtools

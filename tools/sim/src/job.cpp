@@ -1,0 +1,359 @@
+// SPDX-License-Identifier: MIT
+#include "sim_tools/job.hpp"
+
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "can/candump_log.hpp"
+#include "firmware/dsp_chain_port.hpp"
+#include "firmware/estimator_port.hpp"
+#include "sim_target/control.hpp"
+#include "sim_tools/console.hpp"
+
+namespace hrg::simtools {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
+
+// Rate-table schedule, built as a piecewise-linear profile of the case rate.
+struct Schedule {
+  std::vector<sim::ProfilePoint> pts{{0.0, 0.0}};
+  double t = 0.0;
+  void hold(double dt) {
+    t += dt;
+    pts.push_back({t, pts.back().value});
+  }
+  // Turns the case by `angle_rad` at `rate_rad_s` with `ramp_s` ramps.
+  void turn(double angle_rad, double rate_rad_s, double ramp_s) {
+    const double r = std::copysign(rate_rad_s, angle_rad);
+    const double cruise = std::fabs(angle_rad / r) - ramp_s;
+    if (cruise < 0) throw std::invalid_argument("schedule: turn too short for its ramps");
+    pts.push_back({t + ramp_s, r});
+    pts.push_back({t + ramp_s + cruise, r});
+    pts.push_back({t + 2 * ramp_s + cruise, 0.0});
+    t += 2 * ramp_s + cruise;
+  }
+};
+
+}  // namespace
+
+std::array<double, 5> true_parameters(const sim::ResonatorParams& p) {
+  const double nu = p.nu_per_s();
+  const double dw = p.half_split_rad_s();
+  return {nu, nu * p.dmu * std::cos(4 * p.th_mu_rad), nu * p.dmu * std::sin(4 * p.th_mu_rad),
+          dw * std::cos(4 * p.th_w_rad), dw * std::sin(4 * p.th_w_rad)};
+}
+
+double true_drift_rad_s(const sim::ResonatorParams& p, double theta_rad, double q) {
+  // physics.md section 3 (exact in q = a_B/a_A, as the averaged equations give).
+  const double d_nu = p.nu_per_s() * p.dmu * std::sin(4 * (theta_rad - p.th_mu_rad));
+  const double w = p.half_split_rad_s() * std::cos(4 * (theta_rad - p.th_w_rad));
+  return (d_nu * (1 + q * q) - 2 * q * w) / (1 - q * q);
+}
+
+JobConfig default_job(double duration_s, int bias_angles) {
+  JobConfig j;
+  j.description =
+      "seed resonator (5 kHz, Q 5e6, dQ/Q 0.1, split 5e-4 Hz); Earth rate at 55.75 deg N; "
+      "ring-up from rest, rate-table sweep, IEEE 1431 style parked-angle bias test";
+  sim::SimConfig& s = j.sim;
+  s.resonator = sim::ResonatorParams{};  // the seed's example resonator
+  // Axes away from the pickoffs so that all four anisotropy terms are non-zero.
+  s.resonator.th_mu_rad = 15.0 * kDeg;
+  s.resonator.th_w_rad = 40.0 * kDeg;
+  // As sim_target/scenarios/default.toml: 1 uV/sqrt(Hz) pickoff noise over the
+  // 50 kHz band, two samples of DAC pipeline, a resonator at rest (a residual
+  // 1 mV ring).
+  s.adc.noise_v_rms = {2.2e-4, 2.2e-4};
+  s.dac.latency_samples = 2;
+  s.initial.amplitude_v = 0.001;
+  s.seed = 20240531;
+  j.earth_rate_rad_s = sim::kEarthRateRadS * std::sin(j.latitude_deg * kDeg);
+
+  // Ring-up from rest (forcers, then the pump) and lock take about 35 s; the
+  // sweep starts after that. The pattern turns at -K/2 of the case rate.
+  const double k = s.resonator.angular_gain;
+  Schedule sch;
+  sch.hold(45.0);
+  const double sweep_rate = 10.0 * kDeg;  // case rate, pattern at about 2.8 deg/s
+  // Two full 4 theta turns of the pattern: 180 deg of theta.
+  sch.turn(2.0 * (kPi / 2.0) * 2.0 / k, sweep_rate, 1.0);
+  sch.hold(2.0);
+  j.sweep_end_s = sch.t;
+
+  // Bias test: steps of 90/n deg of pattern angle (a 4 theta turn over n parks).
+  const double settle_s = 2.0;
+  const double base_hold_s = 6.0;
+  const double step_case_rad = (kPi / 2.0) / bias_angles * 2.0 / k;
+  const double slew_rate = 20.0 * kDeg;
+  const double step_s = std::fabs(step_case_rad) / slew_rate + 0.5;
+  double hold_s = base_hold_s;
+  const double t_bias0 = sch.t;
+  const double min_total = t_bias0 + bias_angles * (step_s + settle_s + base_hold_s);
+  if (duration_s > min_total) {
+    hold_s = (duration_s - t_bias0) / bias_angles - step_s - settle_s;
+  }
+  for (int i = 0; i < bias_angles; ++i) {
+    if (duration_s > 0 && sch.t + step_s + settle_s + hold_s > duration_s) break;
+    sch.turn(-step_case_rad, slew_rate, 0.5);
+    sch.hold(settle_s);
+    const double t0 = sch.t;
+    sch.hold(hold_s);
+    j.parks.push_back({t0, sch.t});
+  }
+  j.duration_s = duration_s > 0 ? duration_s : sch.t;
+  s.rate_rad_s = sim::Profile::ramps(sch.pts).add_offset(j.earth_rate_rad_s);
+
+  fw::GyroConfig& g = j.gyro;
+  g.angular_gain = k;
+  g.amplitude_set_v = 1.0;
+  // Long windows: the decay-rate information of one window grows as T^3
+  // (slope of a noisy line), so one 1 s window is worth about 20 windows of
+  // 130 ms for a quarter of the excitation-off time.
+  g.windows.length_frames = 1000;
+  g.windows.period_frames = 2000;
+  g.windows.max_wait_frames = 10000;
+  g.windows.bins = 16;
+  g.windows.windows_per_bin = 4;
+  g.windows.min_windows_per_bin = 2;
+  g.windows.condition_good = 50.0;
+  g.windows.coverage_good = 1.0;
+  // The rate table turns the pattern here; commanded rotation is for a base
+  // that never turns (the output is held while the pattern is moved).
+  g.windows.rotate_on_static_base = false;
+  derive_firmware_config(j);
+  return j;
+}
+
+void derive_firmware_config(JobConfig& j) {
+  dsp::ChainConfig& c = j.chain;
+  c.sample_rate_hz = j.sim.adc.sample_rate_hz;
+  c.block_frames = j.sim.adc.block_frames;
+  c.adc_full_scale_v = j.sim.adc.full_scale_v;
+  c.dac_full_scale_v = j.sim.dac.full_scale_v;
+  c.dac_lead_frames = c.block_frames + j.sim.dac.latency_samples + 0.5;
+  c.amplitude_setpoint_v = j.gyro.amplitude_set_v;
+  j.estimator.angular_gain = j.gyro.angular_gain;
+  j.gyro.monitor.amplitude_set_v = j.gyro.amplitude_set_v;
+}
+
+namespace {
+
+void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim::TrueState& ts,
+                double true_angle0, double out0, double raw0) {
+  const fw::GyroStatus& st = g.status();
+  Row row{};
+  row.t_s = st.chain.t_s;
+  row.cx_v = st.chain.cx_v;
+  row.sx_v = st.chain.sx_v;
+  row.cy_v = st.chain.cy_v;
+  row.sy_v = st.chain.sy_v;
+  row.exc = st.excitation_on ? 1 : 0;
+  row.pump_v = st.chain.pump_v;
+  row.temp_c = ts.temp_c;
+  row.rate_dps = ts.rate_rad_s / kDeg;
+  row.f_ref_hz = st.chain.f_ref_hz;
+  row.quad_v = st.chain.a_b_v;
+  row.mode = static_cast<int>(st.mode);
+  row.theta_deg = st.theta_unwrapped_rad / kDeg;
+  row.out_angle_deg = (st.out_angle_rad - out0) / kDeg;
+  row.raw_angle_deg = (st.out_raw_angle_rad - raw0) / kDeg;
+  row.true_angle_deg = (ts.input_angle_rad - true_angle0) / kDeg;
+  row.true_theta_deg = ts.pattern_angle_rad / kDeg;
+  row.a_a_v = st.chain.a_a_v;
+  row.a_b_v = st.chain.a_b_v;
+  row.drift_model_dph = st.drift_rad_s / job.gyro.angular_gain * kRadSToDph;
+  const double q = ts.a_a_v > 0 ? ts.a_b_v / ts.a_a_v : 0.0;
+  row.drift_true_dph = true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) /
+                       job.gyro.angular_gain * kRadSToDph;
+  row.out_valid = st.out_valid ? 1 : 0;
+  r.rows.push_back(row);
+}
+
+void summarise_executive(JobResult& r, const fw::Gyro& g) {
+  const auto& ex = g.executive();
+  for (std::size_t i = 0; i < fw::Gyro::kTaskCount; ++i) {
+    const auto& t = ex.task(i);
+    const auto& s = ex.task_stats()[i];
+    TaskFigures f;
+    f.name = t.name;
+    f.rate_hz = t.rate_hz;
+    f.budget_ns = t.budget_ns;
+    f.min_ns = s.runs ? s.min_ns : 0;
+    f.max_ns = s.max_ns;
+    f.mean_ns = s.runs ? static_cast<double>(s.total_ns) / static_cast<double>(s.runs) : 0.0;
+    f.overruns = s.overruns;
+    f.slips = s.slips;
+    f.runs = s.runs;
+    r.tasks.push_back(f);
+  }
+  r.frames = ex.frame_stats();
+}
+
+void analyse(JobResult& r, const JobConfig& job) {
+  // Tracking: compensated output against the truth while the output is valid.
+  double sum2 = 0;
+  std::size_t n = 0;
+  const double dt_h = 1.0 / job.telemetry_hz / 3600.0;
+  double model_deg = 0, bound_deg = 0;
+  for (const Row& row : r.rows) {
+    if (!row.out_valid) continue;
+    // What the drift model predicts for the raw output: it falls behind the
+    // truth at D/K (Omega K = -2 theta' + D).
+    model_deg -= row.drift_true_dph * dt_h;
+    bound_deg += std::fabs(row.drift_true_dph) * dt_h;
+    if (row.t_s < r.t_operate_s) continue;
+    const double e = row.out_angle_deg - row.true_angle_deg;
+    sum2 += e * e;
+    ++n;
+    r.tracking_max_deg = std::max(r.tracking_max_deg, std::fabs(e));
+  }
+  r.tracking_rms_deg = n ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
+  r.model_error_end_deg = model_deg;
+  r.drift_bound_deg = bound_deg;
+  if (!r.rows.empty()) {
+    const Row& last = r.rows.back();
+    r.raw_error_end_deg = last.raw_angle_deg - last.true_angle_deg;
+    r.comp_error_end_deg = last.out_angle_deg - last.true_angle_deg;
+  }
+
+  // Parked bias: slope of the angle error over each park, in deg/h.
+  std::vector<double> th, braw, bcomp, bmodel;
+  for (const Park& p : job.parks) {
+    std::vector<double> t, eraw, ecomp, theta;
+    double model = 0;
+    for (const Row& row : r.rows) {
+      if (row.t_s < p.t_begin_s || row.t_s > p.t_end_s || !row.out_valid) continue;
+      t.push_back(row.t_s);
+      eraw.push_back(row.raw_angle_deg - row.true_angle_deg);
+      ecomp.push_back(row.out_angle_deg - row.true_angle_deg);
+      theta.push_back(row.theta_deg * kDeg);
+      model += row.drift_true_dph;
+    }
+    if (t.size() < 10) continue;
+    ParkResult pr;
+    double ts = 0;
+    for (double v : theta)
+      ts += v;
+    pr.theta_rad = ts / static_cast<double>(theta.size());
+    pr.bias_raw_dph = slope(t, eraw) * 3600.0;
+    pr.bias_comp_dph = slope(t, ecomp) * 3600.0;
+    // The raw output error grows at -D/K (Omega K = -2 theta' + D).
+    pr.bias_model_dph = -model / static_cast<double>(t.size());
+    r.parks.push_back(pr);
+    th.push_back(pr.theta_rad);
+    braw.push_back(pr.bias_raw_dph);
+    bcomp.push_back(pr.bias_comp_dph);
+    bmodel.push_back(pr.bias_model_dph);
+  }
+  r.fit_raw = fit_bias_4theta(th, braw);
+  r.fit_comp = fit_bias_4theta(th, bcomp);
+  r.fit_model = fit_bias_4theta(th, bmodel);
+
+  // Allan deviation of the compensated output rate over the longest stretch
+  // of valid output without a commanded move (from the last invalid row on).
+  std::size_t first = 0;
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    if (!r.rows[i].out_valid) first = i + 1;
+  }
+  std::vector<double> angle;
+  for (std::size_t i = first; i < r.rows.size(); ++i) {
+    angle.push_back((r.rows[i].out_angle_deg - r.rows[i].true_angle_deg) * kDeg);
+  }
+  r.allan = allan_deviation(angle, 1.0 / job.telemetry_hz);
+}
+
+}  // namespace
+
+JobResult run_job(const JobConfig& job, bool progress, const std::string& can_log) {
+  JobResult r;
+  if (const char* err = dsp::check_chain_config(job.chain)) throw std::invalid_argument(err);
+  sim::SimTarget& target = sim::target();
+  target.configure(job.sim);
+  HostClock timer;
+  fw::DspChainPort chain(job.chain);
+  fw::EstimatorPort ident(job.estimator);
+  // The firmware objects are large (the chain holds its filters): on the heap
+  // here, statically allocated on a board.
+  auto gyro = std::make_unique<fw::Gyro>(target.board(), chain, ident, timer, fw::Pacing::lockstep,
+                                         job.gyro);
+  if (!gyro->board_ok())
+    throw std::invalid_argument(
+        "the simulated board's converters do not "
+        "match the firmware's block layout");
+  std::unique_ptr<can::CandumpLogWriter> log;
+  if (!can_log.empty()) log = std::make_unique<can::CandumpLogWriter>(can_log, "can0");
+
+  const auto frames = static_cast<uint64_t>(std::llround(job.duration_s * fw::kBaseRateHz));
+  const auto row_every =
+      static_cast<uint64_t>(std::max(1.0, std::round(fw::kBaseRateHz / job.telemetry_hz)));
+  r.rows.reserve(frames / row_every + 1);
+  ProgressBar bar(static_cast<double>(frames), progress);
+  double true0 = 0, out0 = 0, raw0 = 0;
+  bool have_ref = false;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  for (uint64_t k = 0; k < frames; ++k) {
+    gyro->run_frame();
+    const fw::GyroStatus& st = gyro->status();
+    r.faults_seen = static_cast<uint16_t>(r.faults_seen | st.faults);
+    if (st.mode == fw::Mode::operate && !r.reached_operate) {
+      r.reached_operate = true;
+      r.t_operate_s = st.chain.t_s;
+    }
+    if (log) {
+      auto& bus = target.can();
+      for (const auto& f : bus.sent()) {
+        log->write(f, static_cast<uint64_t>(st.chain.t_s * 1e9));
+      }
+      r.can_frames += bus.sent().size();
+      bus.clear_sent();
+    } else {
+      r.can_frames += target.can().sent().size();
+      target.can().clear_sent();
+    }
+    if (k % row_every != 0) continue;
+    const sim::TrueState ts = target.true_state();
+    if (!have_ref && st.out_valid) {
+      // Angles are compared from the first valid output on.
+      true0 = ts.input_angle_rad;
+      out0 = st.out_angle_rad;
+      raw0 = st.out_raw_angle_rad;
+      have_ref = true;
+    }
+    record_row(r, job, *gyro, ts, true0, out0, raw0);
+    if (progress && k % 1000 == 0) {
+      bar.update(static_cast<double>(k),
+                 fmt("t=%.0f s %s", st.chain.t_s, fw::to_string(st.mode)).c_str());
+    }
+  }
+  bar.finish();
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  r.sim_s = job.duration_s;
+  r.realtime_factor = r.wall_s > 0 ? r.sim_s / r.wall_s : 0.0;
+  r.realtime_factor_cpu = r.cpu_s > 0 ? r.sim_s / r.cpu_s : 0.0;
+  r.sim_share =
+      r.wall_s > 0 ? static_cast<double>(gyro->status().adc_wait_ns) * 1e-9 / r.wall_s : 0.0;
+  r.final_mode = gyro->status().mode;
+  r.excitation_off_fraction = gyro->scheduler().excitation_off_fraction();
+  r.windows = gyro->scheduler().windows();
+  r.windows_accepted = ident.windows_accepted();
+  r.campaign_done = gyro->scheduler().campaign_done();
+  r.identification = ident.identification();
+  r.truth = true_parameters(job.sim.resonator);
+  r.condition = ident.health().condition;
+  r.coverage = ident.health().coverage;
+  summarise_executive(r, *gyro);
+  if (log) log->flush();
+  analyse(r, job);
+  return r;
+}
+
+}  // namespace hrg::simtools

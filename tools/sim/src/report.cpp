@@ -1,0 +1,293 @@
+// SPDX-License-Identifier: MIT
+#include "sim_tools/report.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "recording/recording_writer.hpp"
+#include "sim_tools/console.hpp"
+#include "sim_tools/json.hpp"
+
+namespace hrg::simtools {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kParamNames[5] = {"nu_per_s", "dnu_c_per_s", "dnu_s_per_s", "dw_c_rad_s",
+                                        "dw_s_rad_s"};
+constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
+
+// Tolerances of the pass/fail checks, in one place.
+constexpr double kTrackSlackFraction = 0.25;  // raw error may differ from the model by this share
+constexpr double kTrackFloorDeg = 0.02;       // plus this (noise, the control-loop drift)
+constexpr double kAdbReduction = 0.5;         // compensation must at least halve the ADB
+
+void bias_json(JsonWriter& w, const char* key, const BiasFit& f) {
+  w.begin_object(key);
+  w.number("adb_dph", f.amplitude());
+  w.number("mean_dph", f.b0);
+  w.number("sin4_dph", f.a_sin4);
+  w.number("cos4_dph", f.b_cos4);
+  w.number("sigma_mean_dph", f.sigma_b0);
+  w.number("residual_rms_dph", f.residual_rms);
+  w.boolean("fitted", f.ok);
+  w.end_object();
+}
+}  // namespace
+
+bool judge(const JobConfig& job, JobResult& r) {
+  r.failures.clear();
+  if (!r.reached_operate) r.failures.push_back("the gyro never reached operate");
+  if (r.final_mode == fw::Mode::safe || r.final_mode == fw::Mode::fault) {
+    r.failures.push_back(std::string("the run ended in ") + fw::to_string(r.final_mode));
+  }
+  if (r.windows >= 3 && !r.identification.valid) {
+    r.failures.push_back("free-decay windows ran but no identification was accepted");
+  }
+  if (r.reached_operate) {
+    const double slack = kTrackSlackFraction * r.drift_bound_deg + kTrackFloorDeg;
+    if (std::fabs(r.raw_error_end_deg - r.model_error_end_deg) > slack) {
+      r.failures.push_back(
+          fmt("raw output error %.4f deg differs from the drift model's %.4f deg "
+              "by more than %.4f deg",
+              r.raw_error_end_deg, r.model_error_end_deg, slack));
+    }
+    if (std::fabs(r.comp_error_end_deg) > r.drift_bound_deg + kTrackFloorDeg) {
+      r.failures.push_back(fmt("compensated output error %.4f deg exceeds the drift bound %.4f deg",
+                               r.comp_error_end_deg, r.drift_bound_deg));
+    }
+  }
+  if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
+      r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
+    r.failures.push_back(
+        fmt("compensation did not halve the angle-dependent bias (%.3f -> %.3f "
+            "deg/h)",
+            r.fit_raw.amplitude(), r.fit_comp.amplitude()));
+  }
+  return r.failures.empty();
+}
+
+std::string report_json(const JobConfig& job, const JobResult& r) {
+  JsonWriter w;
+  w.begin_object();
+  w.string("scenario", job.description);
+  w.number("duration_s", r.sim_s);
+  w.number("wall_s", r.wall_s);
+  w.number("realtime_factor", r.realtime_factor);
+  w.number("realtime_factor_cpu", r.realtime_factor_cpu);
+  w.number("simulation_share", r.sim_share);
+  w.number("excitation_off_fraction", r.excitation_off_fraction);
+  w.boolean("passed", r.failures.empty());
+  w.begin_array("failures");
+  for (const auto& f : r.failures)
+    w.string({}, f);
+  w.end_array();
+
+  w.begin_object("drift");
+  bias_json(w, "raw", r.fit_raw);
+  bias_json(w, "compensated", r.fit_comp);
+  bias_json(w, "model", r.fit_model);
+  w.integer("parked_angles", static_cast<long long>(r.parks.size()));
+  w.begin_array("parks");
+  for (const auto& p : r.parks) {
+    w.begin_object();
+    w.number("theta_deg", p.theta_rad * 180.0 / kPi);
+    w.number("raw_dph", p.bias_raw_dph);
+    w.number("compensated_dph", p.bias_comp_dph);
+    w.number("model_dph", p.bias_model_dph);
+    w.end_object();
+  }
+  w.end_array();
+  w.end_object();
+
+  w.begin_object("identification");
+  w.boolean("accepted", r.identification.valid);
+  w.number("condition_number", r.condition);
+  w.number("coverage", r.coverage);
+  w.integer("windows", r.windows);
+  w.integer("windows_accepted", r.windows_accepted);
+  w.boolean("campaign_done", r.campaign_done);
+  for (int i = 0; i < 5; ++i) {
+    w.begin_object(kParamNames[i]);
+    w.number("estimate", r.identification.p[i]);
+    w.number("sigma", r.identification.sigma[i]);
+    w.number("truth", r.truth[static_cast<std::size_t>(i)]);
+    w.end_object();
+  }
+  w.end_object();
+
+  w.begin_object("tracking");
+  w.number("t_operate_s", r.t_operate_s);
+  w.number("rms_deg", r.tracking_rms_deg);
+  w.number("max_deg", r.tracking_max_deg);
+  w.number("raw_error_end_deg", r.raw_error_end_deg);
+  w.number("compensated_error_end_deg", r.comp_error_end_deg);
+  w.number("model_error_end_deg", r.model_error_end_deg);
+  w.number("drift_bound_deg", r.drift_bound_deg);
+  w.end_object();
+
+  w.begin_object("executive");
+  w.integer("frames", static_cast<long long>(r.frames.frames));
+  w.integer("missed_frames", r.frames.missed_frames);
+  w.integer("deadline_misses", r.frames.deadline_misses);
+  w.number("max_frame_us", r.frames.max_frame_ns / 1e3);
+  w.begin_object("tasks");
+  for (const auto& t : r.tasks) {
+    w.begin_object(t.name);
+    w.integer("rate_hz", t.rate_hz);
+    w.number("budget_us", t.budget_ns / 1e3);
+    w.number("max_us", t.max_ns / 1e3);
+    w.number("mean_us", t.mean_ns / 1e3);
+    w.integer("overruns", t.overruns);
+    w.integer("slips", t.slips);
+    w.end_object();
+  }
+  w.end_object();
+  w.end_object();
+
+  w.begin_array("allan_deviation");
+  for (const auto& p : r.allan) {
+    w.begin_object();
+    w.number("tau_s", p.tau_s);
+    w.number("adev_dph", p.adev * kRadSToDph);
+    w.end_object();
+  }
+  w.end_array();
+  w.integer("can_frames", static_cast<long long>(r.can_frames));
+  w.string("final_mode", fw::to_string(r.final_mode));
+  w.integer("faults_seen", r.faults_seen);
+  w.end_object();
+  return w.str();
+}
+
+void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r) {
+  std::vector<std::string> cols{"t_s",
+                                "cx_v",
+                                "sx_v",
+                                "cy_v",
+                                "sy_v",
+                                "exc",
+                                "pump_v",
+                                "temp_c",
+                                "rate_dps",
+                                "f_ref_hz",
+                                "quad_v",
+                                "mode",
+                                "theta_deg",
+                                "out_angle_deg",
+                                "true_angle_deg",
+                                "raw_angle_deg",
+                                "true_theta_deg",
+                                "a_a_v",
+                                "a_b_v",
+                                "drift_model_dph",
+                                "drift_true_dph",
+                                "out_valid"};
+  recording::RecordingWriter wr(path, cols, job.chain.f_center_hz, job.gyro.angular_gain,
+                                {{"source", "hrg sim (firmware + sim_target in lockstep)"},
+                                 {"scenario", job.description},
+                                 {"quad_v", "a_B, the quadrature wave amplitude"}});
+  std::vector<double> v(cols.size());
+  for (const Row& row : r.rows) {
+    v = {row.t_s,
+         row.cx_v,
+         row.sx_v,
+         row.cy_v,
+         row.sy_v,
+         double(row.exc),
+         row.pump_v,
+         row.temp_c,
+         row.rate_dps,
+         row.f_ref_hz,
+         row.quad_v,
+         double(row.mode),
+         row.theta_deg,
+         row.out_angle_deg,
+         row.true_angle_deg,
+         row.raw_angle_deg,
+         row.true_theta_deg,
+         row.a_a_v,
+         row.a_b_v,
+         row.drift_model_dph,
+         row.drift_true_dph,
+         double(row.out_valid)};
+    wr.write_row(v);
+  }
+  wr.close();
+}
+
+void write_bias_csv(const std::filesystem::path& path, const JobResult& r) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path.string());
+  f << "theta_deg,raw_dph,compensated_dph,model_dph\n";
+  for (const auto& p : r.parks) {
+    f << p.theta_rad * 180.0 / kPi << ',' << p.bias_raw_dph << ',' << p.bias_comp_dph << ','
+      << p.bias_model_dph << '\n';
+  }
+}
+
+void write_allan_csv(const std::filesystem::path& path, const JobResult& r) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path.string());
+  f << "tau_s,adev_dph\n";
+  for (const auto& p : r.allan)
+    f << p.tau_s << ',' << p.adev * kRadSToDph << '\n';
+}
+
+void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
+  TextTable run("run");
+  run.row({"simulated", fmt("%.1f s", r.sim_s)});
+  run.row({"wall", fmt("%.1f s", r.wall_s)});
+  run.row({"realtime factor", fmt("%.1f x wall, %.1f x CPU (fs %u Hz, one core; %.0f %% in "
+                                  "the simulated target)",
+                                  r.realtime_factor, r.realtime_factor_cpu,
+                                  job.sim.adc.sample_rate_hz, 100.0 * r.sim_share)});
+  run.row({"operate from", fmt("%.2f s", r.t_operate_s)});
+  run.row({"final mode", fw::to_string(r.final_mode)});
+  run.row(
+      {"excitation off", fmt("%.2f %% (%u windows, %u accepted)", 100.0 * r.excitation_off_fraction,
+                             r.windows, r.windows_accepted)});
+  run.row({"tracking rms", fmt("%.4f deg (max %.4f)", r.tracking_rms_deg, r.tracking_max_deg)});
+  run.row({"error at end", fmt("raw %.4f deg, model %.4f deg, compensated %.4f deg",
+                               r.raw_error_end_deg, r.model_error_end_deg, r.comp_error_end_deg)});
+  run.print(out);
+
+  TextTable id("identification (estimate +- sigma, truth)");
+  for (int i = 0; i < 5; ++i) {
+    id.row({kParamNames[i], fmt("%+.4e", r.identification.p[i]),
+            fmt("+- %.1e", r.identification.sigma[i]),
+            fmt("%+.4e", r.truth[static_cast<std::size_t>(i)])});
+  }
+  id.row({"condition", fmt("%.1f", r.condition), fmt("coverage %.2f", r.coverage),
+          r.identification.valid ? "accepted" : "not accepted"});
+  id.print(out);
+
+  TextTable bias("angle-dependent bias, b + A sin4th + B cos4th (deg/h, input axis)");
+  bias.row({"", "mean b", "ADB sqrt(A^2+B^2)", "A", "B"});
+  const auto add = [&](const char* name, const BiasFit& f) {
+    bias.row({name, fmt("%+.3f", f.b0), fmt("%.3f", f.amplitude()), fmt("%+.3f", f.a_sin4),
+              fmt("%+.3f", f.b_cos4)});
+  };
+  add("raw", r.fit_raw);
+  add("compensated", r.fit_comp);
+  add("drift model (truth)", r.fit_model);
+  bias.row({"parked angles", fmt("%zu", r.parks.size())});
+  bias.print(out);
+
+  TextTable ex("executive (lockstep; host time per task)");
+  ex.row({"task", "rate", "budget", "max", "mean", "overruns", "slips"});
+  for (const auto& t : r.tasks) {
+    ex.row({t.name, fmt("%u Hz", t.rate_hz), fmt("%.0f us", t.budget_ns / 1e3),
+            fmt("%.1f us", t.max_ns / 1e3), fmt("%.2f us", t.mean_ns / 1e3), fmt("%u", t.overruns),
+            fmt("%u", t.slips)});
+  }
+  ex.print(out);
+  if (r.failures.empty()) {
+    std::fprintf(out, "result: PASS\n");
+  } else {
+    for (const auto& f : r.failures)
+      std::fprintf(out, "FAIL: %s\n", f.c_str());
+  }
+}
+
+}  // namespace hrg::simtools
