@@ -239,6 +239,7 @@ TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
   TelemetryConfig c = TelemetryConfig::defaults();
   c.rate_hz[static_cast<std::size_t>(Tm::wave_x)] = 1000;
   c.rate_hz[static_cast<std::size_t>(Tm::angle)] = 0;  // off
+  c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 1000;
   TelemetryEncoder enc(c, 1000);
   CHECK(enc.config_ok());
   TelemetrySnapshot s;
@@ -254,11 +255,44 @@ TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
   }
   LONGS_EQUAL(100, wave_x);
   LONGS_EQUAL(0, angle);
+  c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 1000;
+  CHECK(c.valid(1000));
+  c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 500;  // halves of a sample must pair
+  CHECK_FALSE(c.valid(1000));
+  c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 1000;
   c.rate_hz[static_cast<std::size_t>(Tm::status)] = 3;  // 1000 / 3 is not whole
   CHECK_FALSE(c.valid(1000));
   TelemetryEncoder bad(c, 1000);
   CHECK_FALSE(bad.config_ok());
   LONGS_EQUAL(10, bad.config().rate_hz[static_cast<std::size_t>(Tm::status)]);
+}
+
+TEST(Telemetry, BothHalvesOfAWaveSampleGoOutInTheSameFrameWithTheSameSeq) {
+  TelemetryEncoder enc(TelemetryConfig::defaults(), 1000);
+  TelemetrySnapshot s;
+  std::array<CanFrame, kTelemetryCount> out;
+  int pairs = 0;
+  for (int k = 0; k < 1000; ++k) {
+    s.cx_v = 1e-3 * k;
+    s.cy_v = -1e-3 * k;
+    const std::size_t n = enc.tick(s, out);
+    const CanFrame* x = nullptr;
+    const CanFrame* y = nullptr;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (out[j].id == telemetry_def(Tm::wave_x).id) x = &out[j];
+      if (out[j].id == telemetry_def(Tm::wave_y).id) y = &out[j];
+    }
+    CHECK((x == nullptr) == (y == nullptr));
+    if (x == nullptr) continue;
+    ++pairs;
+    const MessageDef& mx = telemetry_def(Tm::wave_x);
+    const MessageDef& my = telemetry_def(Tm::wave_y);
+    LONGS_EQUAL(decode_raw(mx.signals[sig::wave_x_seq], *x),
+                decode_raw(my.signals[sig::wave_y_seq], *y));
+    DOUBLES_EQUAL(-decode_signal(mx.signals[sig::cx_v], *x),
+                  decode_signal(my.signals[sig::cy_v], *y), 1e-9);
+  }
+  LONGS_EQUAL(500, pairs);
 }
 
 TEST(Telemetry, DefaultBusLoadIsTheSumOfRateTimesWorstCaseFrameBits) {

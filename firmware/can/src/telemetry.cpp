@@ -22,6 +22,11 @@ TelemetryConfig TelemetryConfig::defaults() {
 }
 
 bool TelemetryConfig::valid(uint32_t base_rate_hz) const {
+  // A recording row is one HRG_WAVE_X and the HRG_WAVE_Y of the same sample.
+  if (rate_hz[static_cast<std::size_t>(Tm::wave_x)] !=
+      rate_hz[static_cast<std::size_t>(Tm::wave_y)]) {
+    return false;
+  }
   for (const auto r : rate_hz) {
     if (r == 0) continue;
     if (r > base_rate_hz || base_rate_hz % r != 0) return false;
@@ -128,7 +133,9 @@ std::size_t TelemetryEncoder::tick(const TelemetrySnapshot& s, std::span<hal::Ca
     if (rate == 0) continue;
     // An invalid base rate leaves rates above it: send those every frame.
     const uint64_t period = rate >= base_rate_hz_ ? 1 : base_rate_hz_ / rate;
-    if ((frame_ + i) % period != 0) continue;
+    // HRG_WAVE_Y goes out in the same frame as HRG_WAVE_X (same sample, same seq).
+    const std::size_t phase = i == static_cast<std::size_t>(Tm::wave_y) ? 0 : i;
+    if ((frame_ + phase) % period != 0) continue;
     encode_now(static_cast<Tm>(i), s, out[n++]);
   }
   ++frame_;

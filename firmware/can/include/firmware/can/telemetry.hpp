@@ -60,7 +60,8 @@ struct TelemetrySnapshot {
 struct TelemetryConfig {
   std::array<uint16_t, kTelemetryCount> rate_hz{};
   static TelemetryConfig defaults();
-  // True when every rate is 0 or divides base_rate_hz.
+  // True when every rate is 0 or divides base_rate_hz, and the two wave
+  // messages (the halves of one sample) have the same rate.
   bool valid(uint32_t base_rate_hz) const;
 };
 
@@ -80,7 +81,8 @@ class TelemetryEncoder {
 
   // Writes the frames due in this base frame into `out` (at most
   // kTelemetryCount) and returns how many. Messages are staggered (message i is
-  // sent when (frame + i) is a multiple of its period) to spread the load.
+  // sent when (frame + i) is a multiple of its period) to spread the load;
+  // HRG_WAVE_Y always goes with HRG_WAVE_X.
   std::size_t tick(const TelemetrySnapshot& s, std::span<hal::CanFrame> out);
   // Encodes one message now (e.g. STATUS on request), advancing its counter.
   void encode_now(Tm message, const TelemetrySnapshot& s, hal::CanFrame& out);

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+
+namespace hrg::can {
+
+struct CanDecodeOptions {
+  std::string log_path;
+  std::string out_path;                // .csv or .csv.gz
+  std::string dbc_path;                // empty: the repository's firmware/can/hrg.dbc
+  std::optional<double> angular_gain;  // overrides HRG_INFO.angular_gain
+  std::optional<double> f_ref_hz;      // overrides the first HRG_LOOPS.pll_freq_hz
+};
+
+// Per-message frame counts and losses counted from the rolling `seq`.
+struct MessageLosses {
+  uint64_t frames = 0;
+  uint64_t lost = 0;
+};
+
+struct CanDecodeSummary {
+  uint64_t frames = 0;          // frames in the log
+  uint64_t unknown_frames = 0;  // identifiers not in the DBC (error frames included)
+  uint64_t rows = 0;            // recording rows (paired HRG_WAVE_X/HRG_WAVE_Y)
+  uint64_t unpaired_wave = 0;   // wave frames whose partner was lost
+  std::map<std::string, MessageLosses> messages;  // by DBC message name
+  double f_ref_hz = 0;
+  double angular_gain = 0;
+  double t0_s = 0;  // log time of the first frame; rows count from it
+};
+
+// Turns a candump -l log of HRG telemetry into an hrg-recording v1, decoding
+// with the DBC. Rows are the HRG_WAVE_X/HRG_WAVE_Y pairs (same seq); pump_v,
+// temp_c, f_ref_hz and mode are the latest HRG_PUMP, HRG_STATUS and HRG_LOOPS
+// values. Losses are counted per message from the sequence counters and
+// written to the metadata. Throws std::runtime_error (naming file and line) on
+// unreadable input or when K or the reference frequency is unknown.
+CanDecodeSummary can_decode(const CanDecodeOptions& options);
+
+// `hrg can-decode LOG -o REC.csv [--dbc FILE] [--angular-gain K] [--f-ref-hz F]`.
+int can_decode_main(std::span<char* const> args);
+
+}  // namespace hrg::can
