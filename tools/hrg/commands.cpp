@@ -4,6 +4,7 @@
 #include <array>
 
 #include "audit/audit_command.hpp"
+#include "can/can_decode.hpp"
 #include "hrg/sim_command.hpp"
 
 namespace hrg::cli {
@@ -11,12 +12,14 @@ namespace hrg::cli {
 int scenario_check_main(std::span<char* const> args);  // scenario_check_command.cpp
 
 namespace {
-constexpr std::array<Command, 4> kCommands{{
+constexpr std::array<Command, 5> kCommands{{
     {"sim", "run the firmware against the simulated gyro (the main job)", &sim_main},
     {"audit", "locate sim/recording mismatches and name the left-out physics",
      &hrg::audit::audit_main},
     {"audit-bench", "confusion matrix of hrg audit on recordings with concealed effects",
      &hrg::audit::audit_bench_main},
+    {"can-decode", "turn a candump log of the CAN telemetry into an hrg-recording v1",
+     &hrg::can::can_decode_main},
     {"scenario-check", "validate simulator scenario files (TOML)", &scenario_check_main},
 }};
 }  // namespace
