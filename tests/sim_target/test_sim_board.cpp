@@ -272,3 +272,44 @@ TEST(SimCan, ReceiveFiltersInjectedFrames) {
   CHECK_EQUAL(0x123u, got.id);
   CHECK(can.receive(got) == hal::Status::would_block);
 }
+
+TEST(SimBoard, AdcOffsetShiftsTheMeanAndDacRailCodesAreCounted) {
+  SimConfig c;
+  c.adc.offset_v = {0.25, -0.5};
+  target().configure(c);
+  hal::Board& b = hal::board();
+  AdcQuantizer aq(c.adc);
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  const auto v = read_one(b, t_ns, clipped);
+  DOUBLES_EQUAL(0.25, aq.to_volts(v[0]), aq.lsb_v());
+  DOUBLES_EQUAL(-0.5, aq.to_volts(v[1]), aq.lsb_v());
+  std::vector<hal::sample_q31> rail(300, INT32_MAX);
+  b.dac.write_block(rail);
+  read_one(b, t_ns, clipped);
+  CHECK_EQUAL(300u, target().counters().dac_saturated);
+  read_one(b, t_ns, clipped);  // nothing queued: 100 frames of underrun
+  CHECK_EQUAL(100u, target().counters().dac_underruns);
+}
+
+TEST(SimBoard, NoiseBurstRaisesTheNoiseForItsDurationOnly) {
+  SimConfig c;
+  c.adc.noise_v_rms = {1e-4, 1e-4};
+  target().configure(c);
+  AdcQuantizer aq(c.adc);
+  target().noise_burst(1e-2, 0.002);
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  double in_burst = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    for (auto w : read_one(hal::board(), t_ns, clipped))
+      in_burst += std::pow(aq.to_volts(w), 2);
+  }
+  double after = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    for (auto w : read_one(hal::board(), t_ns, clipped))
+      after += std::pow(aq.to_volts(w), 2);
+  }
+  DOUBLES_EQUAL(1e-2, std::sqrt(in_burst / 400.0), 1.5e-3);
+  DOUBLES_EQUAL(1e-4, std::sqrt(after / 400.0), 1.5e-5);
+}
