@@ -158,11 +158,10 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
     }
     if (pattern_enabled_ && valid) {
       const double w_rad_s = 2.0 * kPi * out_.pll_freq_hz;
-      const double rate = clamp_abs(
-          cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
-          pattern_max_rate_rad_s_);
-      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2,
-                         cfg_.forcer_max_v);
+      const double rate =
+          clamp_abs(cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
+                    pattern_max_rate_rad_s_);
+      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2, cfg_.forcer_max_v);
     }
   }
   out_.ring_up = ring_up_;
@@ -177,7 +176,8 @@ template <typename T>
 void Chain<T>::synthesize(uint32_t phase_block_start, std::span<q31_t> dac) const {
   const std::size_t n = cfg_.block_frames;
   if (!pump_on_ && !forcers_on_) {
-    for (std::size_t j = 0; j < kChainDacChannels * n; ++j) dac[j] = 0;
+    for (std::size_t j = 0; j < kChainDacChannels * n; ++j)
+      dac[j] = 0;
     return;
   }
   const double inv_fs = 1.0 / cfg_.dac_full_scale_v;
@@ -188,8 +188,11 @@ void Chain<T>::synthesize(uint32_t phase_block_start, std::span<q31_t> dac) cons
       return static_cast<T>(v * inv_fs);
     }
   };
-  // Forcer x = A cos psi + B sin psi, forcer y = C cos psi + D sin psi.
-  const T pump = coef(v0_v_);
+  // Every channel is A cos psi + B sin psi: pump V0 cos(psi + phi) =
+  // V0 cos phi cos psi - V0 sin phi sin psi, forcers as in chain.hpp. One
+  // table lookup pair per frame serves all three.
+  const T pc = coef(v0_v_ * std::cos(cfg_.pump_phase_rad));
+  const T ps = coef(-v0_v_ * std::sin(cfg_.pump_phase_rad));
   const T fxc = coef(-u_q_v_ * s2_);
   const T fxs = coef(-u_a_v_ * c2_ + u_r_v_ * s2_);
   const T fyc = coef(u_q_v_ * c2_);
@@ -198,17 +201,14 @@ void Chain<T>::synthesize(uint32_t phase_block_start, std::span<q31_t> dac) cons
   // to 2^20 frames).
   const auto lead = static_cast<uint32_t>(
       static_cast<uint64_t>(static_cast<double>(step_) * cfg_.dac_lead_frames + 0.5));
-  const uint32_t psi0 = phase_block_start + lead + phase_of_rad(wave_phase_rad_);
-  const uint32_t pump_off = phase_of_rad(cfg_.pump_phase_rad);
-  uint32_t psi = psi0;
+  uint32_t psi = phase_block_start + lead + phase_of_rad(wave_phase_rad_);
   q31_t* d = dac.data();
   for (std::size_t j = 0; j < n; ++j) {
     const T c = cos_turns<T>(psi);
     const T s = sin_turns<T>(psi);
-    const T cp = cos_turns<T>(psi + pump_off);
-    d[3 * j] = Ops::to_q31(Ops::mul(pump, cp));
-    d[3 * j + 1] = Ops::to_q31(Ops::add(Ops::mul(fxc, c), Ops::mul(fxs, s)));
-    d[3 * j + 2] = Ops::to_q31(Ops::add(Ops::mul(fyc, c), Ops::mul(fys, s)));
+    d[3 * j] = Ops::mac2_to_q31(pc, c, ps, s);
+    d[3 * j + 1] = Ops::mac2_to_q31(fxc, c, fxs, s);
+    d[3 * j + 2] = Ops::mac2_to_q31(fyc, c, fys, s);
     psi += step_;
   }
 }

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <vector>
 
+#include "dsp/chain.hpp"
 #include "dsp/demodulator.hpp"
 #include "dsp/fixed.hpp"
 #include "dsp/nco.hpp"
@@ -33,7 +34,33 @@ double run(const std::vector<q31_t>& frames, int blocks) {
   }
   return sum;
 }
+// Whole chain per block (fast path, wave variables, loops, synthesis), with
+// excitation on so every part runs.
+template <typename T>
+double run_chain(const std::vector<q31_t>& frames, int blocks) {
+  ChainConfig cfg;
+  cfg.f_center_hz = 5000.2;
+  static Chain<T> chain(cfg);
+  chain.reset();
+  chain.set_excitation(true);
+  std::vector<q31_t> dac(3 * kL);
+  double sum = 0.0;
+  for (int b = 0; b < blocks; ++b) {
+    chain.process(frames, dac);
+    sum += chain.outputs().theta_A_rad + static_cast<double>(dac[7]);
+  }
+  return sum;
+}
 }  // namespace
+
+extern "C" __attribute__((noinline)) double hrg_bench_chain_q31(const std::vector<q31_t>& f,
+                                                                int blocks) {
+  return run_chain<q31_t>(f, blocks);
+}
+extern "C" __attribute__((noinline)) double hrg_bench_chain_f32(const std::vector<q31_t>& f,
+                                                                int blocks) {
+  return run_chain<float>(f, blocks);
+}
 
 extern "C" __attribute__((noinline)) double hrg_bench_fast_path_q31(const std::vector<q31_t>& f,
                                                                     int blocks) {
@@ -50,7 +77,7 @@ extern "C" __attribute__((noinline)) double hrg_bench_fast_path_f64(const std::v
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: %s q31|f32|f64 BLOCKS\n", argv[0]);
+    std::fprintf(stderr, "usage: %s q31|f32|f64|chain_q31|chain_f32 BLOCKS\n", argv[0]);
     return 2;
   }
   const int blocks = std::atoi(argv[2]);
@@ -66,8 +93,12 @@ int main(int argc, char** argv) {
     r = hrg_bench_fast_path_f32(frames, blocks);
   } else if (std::strcmp(argv[1], "f64") == 0) {
     r = hrg_bench_fast_path_f64(frames, blocks);
+  } else if (std::strcmp(argv[1], "chain_q31") == 0) {
+    r = hrg_bench_chain_q31(frames, blocks);
+  } else if (std::strcmp(argv[1], "chain_f32") == 0) {
+    r = hrg_bench_chain_f32(frames, blocks);
   } else {
-    std::fprintf(stderr, "unknown type '%s' (q31, f32 or f64)\n", argv[1]);
+    std::fprintf(stderr, "unknown mode '%s' (q31, f32, f64, chain_q31, chain_f32)\n", argv[1]);
     return 2;
   }
   std::printf("%s: %d blocks of %u frames, checksum %.9f\n", argv[1], blocks, kL, r);

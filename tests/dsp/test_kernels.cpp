@@ -2,6 +2,7 @@
 // Fixed-point helpers, NCO and sine/cosine: contracts held at the rails.
 #include "dsp/fixed.hpp"
 #include "dsp/nco.hpp"
+#include "dsp/sample.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -37,6 +38,20 @@ TEST(FixedHelpers, MultiplyRoundsToNearestAndSaturatesMinusOneSquared) {
   CHECK_EQUAL(1, mul_q31_rnd(1, 1 << 30));
   CHECK_EQUAL(0, mul_q31_rnd(-1, 1 << 30));   // -0.5 LSB ties toward +inf
   CHECK_EQUAL(-1, mul_q31_rnd(-3, 1 << 29));  // -0.75 -> -1
+}
+
+TEST(FixedHelpers, SynthesisMacSaturatesAtTheRailsWithoutOverflowingTheSum) {
+  using Ops = SampleOps<q31_t>;
+  CHECK_EQUAL(INT32_MAX, Ops::mac2_to_q31(INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX));
+  CHECK_EQUAL(INT32_MIN, Ops::mac2_to_q31(INT32_MIN, INT32_MAX, INT32_MIN, INT32_MAX));
+  CHECK_EQUAL(INT32_MAX, Ops::mac2_to_q31(INT32_MIN, -INT32_MAX, INT32_MIN, -INT32_MAX));
+  // 0.5 * 0.5 + 0.25 * 0.5 = 0.375, exact; ties of the single rounding go up
+  CHECK_EQUAL(3 << 28, Ops::mac2_to_q31(1 << 30, 1 << 30, 1 << 29, 1 << 30));
+  CHECK_EQUAL(1, Ops::mac2_to_q31(1, 1 << 30, 0, 0));
+  CHECK_EQUAL(0, Ops::mac2_to_q31(-1, 1 << 30, 0, 0));
+  // float twin: same arithmetic, saturating conversion
+  CHECK_EQUAL(INT32_MAX, SampleOps<float>::mac2_to_q31(1.0f, 1.0f, 1.0f, 1.0f));
+  CHECK_EQUAL(INT32_MIN, SampleOps<double>::mac2_to_q31(-1.0, 1.0, -1.0, 1.0));
 }
 
 TEST(FixedHelpers, ConversionFromDoubleRoundsAndSaturates) {

@@ -61,6 +61,10 @@ void helpers_at_the_rails(Report& r) {
   r.check(q31_from_f64_sat(2.0) == kQ31Max && q31_from_f64_sat(-2.0) == kQ31Min,
           "q31_from_f64_sat saturates");
   r.check(sat_rnd_q31_to_q15(kQ31Max) == INT16_MAX, "sat_rnd_q31_to_q15 saturates");
+  using Ops = SampleOps<q31_t>;
+  r.check(Ops::mac2_to_q31(kQ31Max, kQ31Max, kQ31Max, kQ31Max) == kQ31Max, "mac2 saturates up");
+  r.check(Ops::mac2_to_q31(kQ31Min, kQ31Max, kQ31Min, kQ31Max) == kQ31Min, "mac2 saturates down");
+  r.check(Ops::mac2_to_q31(-1, 1 << 30, 0, 0) == 0, "mac2 ties toward +inf");
   for (q31_t v : std::array<q31_t, 4>{kQ31Max, kQ31Min, 0x12345678, -0x0FEDCBA9}) {
     r.digest_word(mul_q31_rnd(v, 0x5A5A5A5A));
     r.digest_word(add_q31_sat(v, v));

@@ -32,6 +32,10 @@ struct FloatSampleOps {
   // a * b in the value scale.
   static value_t mul(value_t a, value_t b) { return a * b; }
   static value_t add(value_t a, value_t b) { return a + b; }
+  // a c + b s -> Q1.31 converter word, rounding to nearest, saturating.
+  static q31_t mac2_to_q31(value_t a, value_t c, value_t b, value_t s) {
+    return to_q31(a * c + b * s);
+  }
 };
 
 template <>
@@ -58,6 +62,13 @@ struct SampleOps<q31_t> {
   static value_t mul(value_t a, value_t b) { return mul_q31_rnd(a, b); }
   // Saturating add.
   static value_t add(value_t a, value_t b) { return add_q31_sat(a, b); }
+  // a c + b s -> Q1.31 (drive synthesis: coefficients a, b, table values c, s).
+  // Input scaling: Q1.31; |c|, |s| <= 1 - 2^-31 (sin_turns never returns -1).
+  // Overflow: the Q2.62 sum stays below 2^63 for any a, b; the result
+  // saturates to Q1.31. Rounding: once, to nearest, ties toward +inf.
+  static q31_t mac2_to_q31(value_t a, value_t c, value_t b, value_t s) {
+    return sat_q63_to_q31(rshift_q63_rnd(mul_q31_q63(a, c) + mul_q31_q63(b, s), 31));
+  }
 };
 
 }  // namespace hrg::dsp
