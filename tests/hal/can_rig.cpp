@@ -24,6 +24,7 @@
 
 #include "can/candump_log.hpp"
 #include "firmware/can/command.hpp"
+#include "firmware/can/link.hpp"
 #include "firmware/can/telemetry.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/linux_clock.hpp"
@@ -102,8 +103,8 @@ int cmd_run(const char* iface, double seconds) {
     std::fprintf(stderr, "can_rig: cannot open %s\n", iface);
     return 1;
   }
-  const hal::CanFilter commands[] = {{kCommandIdFirst, 0x7F0}};
-  can.set_filters(commands);
+  CanLink link(can, kBaseHz / 10);  // restart after 100 ms bus-off
+  link.init();
   hal::linux_board::GpiodOutput exc_line;
   hal::linux_board::LineConfig lc;
   lc.chip = std::getenv("HRG_GPIO_CHIP") ? std::getenv("HRG_GPIO_CHIP") : "gpiochip0";
@@ -118,15 +119,13 @@ int cmd_run(const char* iface, double seconds) {
 
   hal::linux_board::LinuxClock clock;
   TelemetryEncoder enc(TelemetryConfig::defaults(), kBaseHz);
-  CommandValidator validator;
   RigState st;
   if (have_gpio) exc_line.write(true);
   TelemetrySnapshot snap;
   snap.pll_freq_hz = 5000.0;
   snap.angular_gain = 0.554;
   snap.temp_c = 25.0;
-  int toggles = 0, readback_errors = 0, missed = 0, accepted = 0, refused = 0;
-  uint64_t bus_off_frame = 0;
+  int toggles = 0, readback_errors = 0, missed = 0;
   double max_toggle_late_ms = 0;
   const uint64_t frames = static_cast<uint64_t>(seconds * kBaseHz);
   const uint64_t t0 = clock.now_ns();
@@ -138,23 +137,14 @@ int cmd_run(const char* iface, double seconds) {
   for (; k < frames && g_stop == 0; ++k) {
     if (clock.sleep_until_ns(t0 + k * kPeriodNs) == Status::timeout) ++missed;
     // Commands first: a command acts in the frame it arrives in.
-    CanFrame in;
-    while (can.receive(in) == Status::ok) {
-      fw::can::ControllerView view{st.mode, 0, false, st.ident, st.agc_v};
-      const CommandOutcome o = validator.process(in, view);
-      if (!o.for_us) continue;
-      can.send(o.reply);
-      if (o.result != CommandResult::accepted) {
-        ++refused;
-        continue;
-      }
-      ++accepted;
-      apply(o.command, st, k);
-      if (o.command.id == Cmd::status_request) {
+    Command cmd;
+    while (link.poll({st.mode, 0, false, st.ident, st.agc_v}, cmd)) {
+      apply(cmd, st, k);
+      if (cmd.id == Cmd::status_request) {
         CanFrame status;
         snap.mode = st.mode;
         enc.encode_now(Tm::status, snap, status);
-        can.send(status);
+        link.send({&status, 1});
       }
     }
     // Window schedule: free decay for length_s at the start of every period.
@@ -175,14 +165,7 @@ int cmd_run(const char* iface, double seconds) {
         if (late_ms > max_toggle_late_ms) max_toggle_late_ms = late_ms;
       }
     }
-    // Bus-off policy: restart after 100 ms off the bus.
-    if (can.state() == hal::CanState::bus_off) {
-      if (bus_off_frame == 0) bus_off_frame = k;
-      if (k - bus_off_frame >= kBaseHz / 10) {
-        can.restart();
-        bus_off_frame = 0;
-      }
-    }
+    link.service();
     snap.cx_v = exc ? st.agc_v : st.agc_v * 0.999;
     snap.mode = st.mode;
     snap.exc_on = exc;
@@ -201,12 +184,13 @@ int cmd_run(const char* iface, double seconds) {
   }
   const auto c = can.counters();
   std::printf(
-      "rig: %s %.1f s: frames %llu, missed deadlines %d, commands accepted %d refused %d, "
+      "rig: %s %.1f s: frames %llu, missed deadlines %d, commands accepted %u refused %u, "
       "excitation toggles %d (sysfs read-back errors %d, latest %.3f ms after its frame), "
       "CAN tx %u, tx_queue_full %u, error frames %u, bus-off %u, restarts %u, state %d\n",
-      iface, static_cast<double>(k) / kBaseHz, static_cast<unsigned long long>(k), missed, accepted,
-      refused, toggles, readback_errors, max_toggle_late_ms, c.tx_frames, c.tx_queue_full,
-      c.error_frames, c.bus_off_events, c.restarts, static_cast<int>(can.state()));
+      iface, static_cast<double>(k) / kBaseHz, static_cast<unsigned long long>(k), missed,
+      link.stats().commands_accepted, link.stats().commands_refused, toggles, readback_errors,
+      max_toggle_late_ms, c.tx_frames, c.tx_queue_full, c.error_frames, c.bus_off_events,
+      c.restarts, static_cast<int>(can.state()));
   if (!have_gpio) std::printf("rig: no GPIO line (%s)\n", lc.chip);
   return readback_errors == 0 ? 0 : 1;
 }

@@ -89,7 +89,8 @@ int check_log(const char* path) {
   std::map<uint32_t, int> losses;
   std::map<uint32_t, int> last_seq;
   int last_exc = -1;
-  double t_fall = -1, t_last_fall = -1;
+  long long wave_index = 0, n_fall = -1, n_last_fall = -1;
+  double t_last_fall = -1, max_wall_err_ms = 0;
   int falls = 0, bad_spacing = 0, bad_length = 0;
   double info_period = 0, info_length = 0;
   int status_mode = -1, status_exc = -1, bus_off = 0, restarts = 0;
@@ -114,27 +115,34 @@ int check_log(const char* path) {
     losses[f.id] += gap;
     last_seq[f.id] = seq;
     if (f.id == can::telemetry_def(can::Tm::wave_x).id) {
+      // Window edges are measured in samples (HRG_WAVE_X frames at 500 Hz, lost
+      // ones included through seq): the firmware's time base, exact whatever
+      // the scheduling. The 1.0 s / 0.2 s schedule is 500 / 100 samples. The
+      // log's receive time of each edge is reported beside it.
+      wave_index += 1 + gap;
       const int exc = static_cast<int>(sig(f, "exc"));
-      // Edges are timed only across consecutive frames and while the schedule runs.
-      if (gap != 0 || ident_stopped) {
+      if (gap != 0 || ident_stopped) {  // an edge may have been lost: start over
         last_exc = -1;
-        t_fall = -1;
-        t_last_fall = -1;
+        n_fall = -1;
+        n_last_fall = -1;
       }
       if (last_exc == 1 && exc == 0) {
-        if (t_last_fall >= 0 && std::fabs(t - t_last_fall - 1.0) > 0.05) {
-          std::printf("check: window period %.3f s at t = %.3f s\n", t - t_last_fall, t);
-          ++bad_spacing;
+        if (n_last_fall >= 0) {
+          const double wall_err_ms = 1e3 * std::fabs(t - t_last_fall - 1.0);
+          if (wall_err_ms > max_wall_err_ms) max_wall_err_ms = wall_err_ms;
+          if (wave_index - n_last_fall != 500) {
+            std::printf("check: window period %lld samples\n", wave_index - n_last_fall);
+            ++bad_spacing;
+          }
         }
+        n_last_fall = wave_index;
+        n_fall = wave_index;
         t_last_fall = t;
-        t_fall = t;
         ++falls;
       }
-      if (last_exc == 0 && exc == 1 && t_fall >= 0) {
-        if (std::fabs(t - t_fall - 0.2) > 0.05) {
-          std::printf("check: window length %.3f s at t = %.3f s\n", t - t_fall, t);
-          ++bad_length;
-        }
+      if (last_exc == 0 && exc == 1 && n_fall >= 0 && wave_index - n_fall != 100) {
+        std::printf("check: window length %lld samples\n", wave_index - n_fall);
+        ++bad_length;
       }
       last_exc = exc;
       if (restarts > 0) ++wave_after_restart;
@@ -171,8 +179,10 @@ int check_log(const char* path) {
   if (losses[wave] > 55 * bus_off + count[wave] / 100) {
     rc |= fail("HRG_WAVE_X losses beyond the bus-off interval");
   }
-  std::printf("check: excitation windows %d (period errors %d, length errors %d)\n", falls,
-              bad_spacing, bad_length);
+  std::printf(
+      "check: excitation windows %d (period errors %d, length errors %d, in samples); "
+      "log-time period error up to %.1f ms\n",
+      falls, bad_spacing, bad_length, max_wall_err_ms);
   if (falls < 2 || bad_spacing != 0 || bad_length != 0) rc |= fail("window boundaries");
   std::printf("check: INFO window %.3f s / %.3f s; last STATUS mode %d exc %d\n", info_period,
               info_length, status_mode, status_exc);

@@ -75,7 +75,7 @@ done
 sleep 1.3
 # A controller error frame reporting bus-off, as a real controller would.
 cansend vcan0 20000040#0000000000000000
-sleep 1.5
+sleep 2.5
 for c in IDENT_STOP SAFE STATUS2; do
   send $c
   sleep 0.1

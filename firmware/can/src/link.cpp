@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/can/link.hpp"
+
+namespace hrg::fw::can {
+
+namespace {
+constexpr int kMaxFramesPerPoll = 16;  // bounds the time spent per base frame
+}
+
+CanLink::CanLink(hal::CanBus& bus, uint32_t restart_after_frames)
+    : bus_(bus), restart_after_frames_(restart_after_frames) {}
+
+hal::Status CanLink::init() {
+  const hal::CanFilter commands[] = {{kCommandIdFirst, 0x7F0}};
+  return bus_.set_filters(commands);
+}
+
+bool CanLink::poll(const ControllerView& state, Command& out) {
+  for (int i = 0; i < kMaxFramesPerPoll; ++i) {
+    hal::CanFrame f;
+    if (bus_.receive(f) != hal::Status::ok) return false;
+    const CommandOutcome o = validator_.process(f, state);
+    if (!o.for_us) continue;
+    send({&o.reply, 1});
+    if (o.result != CommandResult::accepted) {
+      ++stats_.commands_refused;
+      continue;
+    }
+    ++stats_.commands_accepted;
+    out = o.command;
+    return true;
+  }
+  return false;
+}
+
+void CanLink::send(std::span<const hal::CanFrame> frames) {
+  for (const auto& f : frames) {
+    if (bus_.send(f) != hal::Status::ok) ++stats_.tx_refused;
+  }
+}
+
+void CanLink::service() {
+  if (bus_.state() != hal::CanState::bus_off) {
+    off_frames_ = 0;
+    return;
+  }
+  if (++off_frames_ < restart_after_frames_) return;
+  off_frames_ = 0;
+  ++stats_.restarts;
+  bus_.restart();
+}
+
+}  // namespace hrg::fw::can

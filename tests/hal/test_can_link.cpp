@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: MIT
+// CanLink over a fake bus: every command is answered, one accepted command per
+// poll, refusals are dropped, telemetry refusals are counted, and bus-off is
+// left by a restart after the configured number of frames. The fake has tests
+// of its own first.
+#include <deque>
+#include <vector>
+
+#include "fake_can_bus.hpp"
+#include "firmware/can/link.hpp"
+
+#include "support/cpputest.hpp"
+
+using namespace hrg::fw::can;
+using hrg::fw::Mode;
+using hrg::hal::CanFrame;
+using hrg::hal::CanState;
+using hrg::hal::Status;
+using hrg::test::FakeCanBus;
+
+TEST_GROUP(FakeCanBus) { FakeCanBus bus; };
+
+TEST(FakeCanBus, ReceivesWhatTheBackDoorQueuedInOrder) {
+  CanFrame a;
+  a.id = 1;
+  CanFrame b;
+  b.id = 2;
+  bus.push_rx(a);
+  bus.push_rx(b);
+  CanFrame f;
+  CHECK(Status::ok == bus.receive(f));
+  LONGS_EQUAL(1, f.id);
+  CHECK(Status::ok == bus.receive(f));
+  LONGS_EQUAL(2, f.id);
+  CHECK(Status::would_block == bus.receive(f));
+}
+
+TEST(FakeCanBus, RefusesSendsWhenToldAndWhileBusOff) {
+  CanFrame f;
+  bus.set_send_result(Status::would_block);
+  CHECK(Status::would_block == bus.send(f));
+  LONGS_EQUAL(1, bus.counters().tx_queue_full);
+  bus.set_send_result(Status::ok);
+  bus.set_state(CanState::bus_off);
+  CHECK(Status::bus_off == bus.send(f));
+  CHECK(Status::ok == bus.restart());
+  CHECK(Status::ok == bus.send(f));
+  LONGS_EQUAL(1, bus.sent().size());
+}
+
+TEST_GROUP(CanLink) {
+  FakeCanBus bus;
+  CanLink link{bus, 100};
+  ControllerView operating() {
+    ControllerView v;
+    v.mode = Mode::operate;
+    v.agc_setpoint_v = 1.0;
+    return v;
+  }
+  Reply last_reply() {
+    Reply r;
+    CHECK(!bus.sent().empty());
+    CHECK(decode_reply(bus.sent().back(), r));
+    return r;
+  }
+};
+
+TEST(CanLink, InitAcceptsOnlyTheCommandRange) {
+  CHECK(Status::ok == link.init());
+  LONGS_EQUAL(1, bus.filters().size());
+  LONGS_EQUAL(0x080, bus.filters()[0].id);
+  LONGS_EQUAL(0x7F0, bus.filters()[0].mask);
+}
+
+TEST(CanLink, AnAcceptedCommandIsReturnedAndAnswered) {
+  bus.push_rx(encode_agc(1.1, 1));
+  Command c;
+  CHECK(link.poll(operating(), c));
+  CHECK(c.id == Cmd::agc);
+  DOUBLES_EQUAL(1.1, c.agc_setpoint_v, 1e-9);
+  LONGS_EQUAL(static_cast<int>(CommandResult::accepted), static_cast<int>(last_reply().result));
+  LONGS_EQUAL(1, link.stats().commands_accepted);
+}
+
+TEST(CanLink, RefusedCommandsAreAnsweredAndDroppedAndTheNextIsReturned) {
+  CanFrame bad = encode_agc(1.1, 1);
+  bad.data[0] ^= 1;  // checksum now wrong
+  bus.push_rx(bad);
+  CanFrame telemetry;
+  telemetry.id = 0x100;  // not a command: no reply
+  bus.push_rx(telemetry);
+  bus.push_rx(encode_status_request(2));
+  Command c;
+  CHECK(link.poll(operating(), c));
+  CHECK(c.id == Cmd::status_request);
+  LONGS_EQUAL(2, bus.sent().size());  // two replies
+  Reply r;
+  CHECK(decode_reply(bus.sent()[0], r));
+  LONGS_EQUAL(static_cast<int>(CommandResult::bad_checksum), static_cast<int>(r.result));
+  LONGS_EQUAL(1, link.stats().commands_refused);
+}
+
+TEST(CanLink, OneCommandPerPollSoTheNextSeesTheAppliedState) {
+  bus.push_rx(encode_ident(true, 1));
+  bus.push_rx(encode_ident(true, 2));
+  Command c;
+  CHECK(link.poll(operating(), c));
+  // The firmware applied the first: identification now runs, so a second
+  // start is refused against the new state.
+  ControllerView running = operating();
+  running.ident_active = true;
+  CHECK_FALSE(link.poll(running, c));
+  LONGS_EQUAL(static_cast<int>(CommandResult::wrong_state), static_cast<int>(last_reply().result));
+}
+
+TEST(CanLink, TelemetryRefusedByAFullQueueIsCountedNotQueued) {
+  CanFrame frames[3];
+  bus.set_send_result(Status::would_block);
+  link.send(frames);
+  LONGS_EQUAL(3, link.stats().tx_refused);
+  LONGS_EQUAL(3, bus.counters().tx_queue_full);
+  bus.set_send_result(Status::ok);
+  link.send(frames);
+  LONGS_EQUAL(3, link.stats().tx_refused);
+  LONGS_EQUAL(3, bus.sent().size());
+}
+
+TEST(CanLink, BusOffIsLeftByOneRestartAfterTheConfiguredFrames) {
+  bus.set_state(CanState::bus_off);
+  for (int k = 0; k < 99; ++k)
+    link.service();
+  LONGS_EQUAL(0, bus.restart_calls());
+  link.service();  // the 100th frame off the bus
+  LONGS_EQUAL(1, bus.restart_calls());
+  CHECK(CanState::error_active == bus.state());
+  for (int k = 0; k < 500; ++k)
+    link.service();
+  LONGS_EQUAL(1, bus.restart_calls());
+  LONGS_EQUAL(1, link.stats().restarts);
+}
