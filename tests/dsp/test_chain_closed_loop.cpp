@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The chain closing its loops on the full-rate simulated resonator
 // (sim_target, default resonator: 5 kHz, Q 5e6, split 5e-4 Hz, dQ/Q 0.1).
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -57,28 +58,33 @@ TEST(ClosedLoop, PllAcquiresFromTwoHertzOffInUnderTwoSecondsOverAGrid) {
 }
 
 TEST(ClosedLoop, PllTracksAHalfHertzPerSecondRampWithinOneMilliradian) {
-  // GIVEN a resonance that ramps at 0.5 Hz/s (thermal frequency shift of
-  // 100 ppm/degC with the temperature ramping at 1 degC/s for 4 s)
-  hrg::sim::Effects fx;
-  fx.thermal_frequency.enabled = true;
-  fx.thermal_frequency.ppm_per_c = 100.0;
-  ChainRig<q31_t> rig(rig_config(), {}, {}, fx);
-  rig.resonator().set_temperature_profile(hrg::sim::Profile::ramps({{1.0, 25.0}, {5.0, 29.0}}));
-  rig.resonator().set_standing_wave(1.0, 0.2);
-  rig.chain().set_excitation(true);
-  // WHEN the loops run through the ramp
-  double worst = 0.0;
-  rig.run(5.0, [&] {
-    if (rig.time_s() > 1.5) worst = std::fmax(worst, std::fabs(rig.out().phase_err_rad));
-  });
-  // THEN the phase error stays below 1 mrad (type-2 loop: r / wn^2 = 0.55 mrad)
-  const double predicted = 2 * kPi * 0.5 / std::pow(2 * kPi * 12.0, 2);
-  std::printf("\n  PLL on a 0.5 Hz/s ramp: max |phase error| %.3e rad (r/wn^2 = %.3e)\n", worst,
-              predicted);
-  CHECK(worst < 1e-3);
-  DOUBLES_EQUAL(predicted, worst, 0.3 * predicted);
-  CHECK(rig.out().locked);
-  DOUBLES_EQUAL(5002.0, rig.out().pll_freq_hz, 0.01);
+  for (double sign : {1.0, -1.0}) {
+    // GIVEN a resonance that ramps at +-0.5 Hz/s (thermal frequency shift of
+    // 100 ppm/degC with the temperature ramping at 1 degC/s for 4 s)
+    hrg::sim::Effects fx;
+    fx.thermal_frequency.enabled = true;
+    fx.thermal_frequency.ppm_per_c = 100.0;
+    ChainRig<q31_t> rig(rig_config(), {}, {}, fx);
+    rig.resonator().set_temperature_profile(
+        hrg::sim::Profile::ramps({{1.0, 25.0}, {5.0, 25.0 + 4.0 * sign}}));
+    rig.resonator().set_standing_wave(1.0, 0.2);
+    rig.chain().set_excitation(true);
+    // WHEN the loops run through the ramp
+    double worst = 0.0;
+    rig.run(5.0, [&] {
+      if (rig.time_s() > 1.5) worst = std::fmax(worst, std::fabs(rig.out().phase_err_rad));
+    });
+    // THEN the phase error stays below 1 mrad (type-2 loop: r / wn^2 = 0.55 mrad)
+    const double predicted = 2 * kPi * 0.5 / std::pow(2 * kPi * 12.0, 2);
+    std::printf("\n  PLL on a %+.1f Hz/s ramp: max |phase error| %.3e rad (r/wn^2 = %.3e)\n",
+                0.5 * sign, worst, predicted);
+    CHECK(worst < 1e-3);
+    DOUBLES_EQUAL(predicted, worst, 0.3 * predicted);
+    CHECK(rig.out().locked);
+    DOUBLES_EQUAL(5000.0 + 2.0 * sign, rig.out().pll_freq_hz, 0.01);
+    // and the amplitude loop is not disturbed by the moving frequency
+    DOUBLES_EQUAL(1.0, rig.out().wave.a_A, 1e-4);
+  }
 }
 
 TEST(ClosedLoop, AgcHoldsTheAmplitudeAndQuadratureIsNulledInSteadyState) {
@@ -121,9 +127,12 @@ TEST(ClosedLoop, AgcHoldsTheAmplitudeAndQuadratureIsNulledInSteadyState) {
 
 TEST(ClosedLoop, LoopsRecoverWithinOneSecondAfterATwoSecondFreeDecayWindow) {
   double worst_settle_s = 0.0, worst_overshoot = 0.0, worst_decay = 0.0, worst_growth = 0.0;
-  for (double theta : {22.5 * kDeg, -22.5 * kDeg, 5.0 * kDeg, 40.0 * kDeg}) {
-    // GIVEN settled loops
-    ChainRig<q31_t> rig(rig_config());
+  for (int run = 0; run < 8; ++run) {
+    // GIVEN settled loops, over a grid of pattern angles and NCO start offsets
+    const double theta = std::array<double, 4>{22.5, -22.5, 5.0, 40.0}[run % 4] * kDeg;
+    ChainConfig cfg = rig_config();
+    cfg.f_center_hz = 5000.0 + (run < 4 ? -2.0 : 2.0);
+    ChainRig<q31_t> rig(cfg);
     rig.resonator().set_standing_wave(1.0, theta);
     rig.chain().set_excitation(true);
     rig.run(3.0);
@@ -159,27 +168,36 @@ TEST(ClosedLoop, LoopsRecoverWithinOneSecondAfterATwoSecondFreeDecayWindow) {
 }
 
 TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
-  // GIVEN the resonator at rest and a small set point (ring-up is slow: the
-  // 5 V forcer drive raises a_A by g u / 2w = 0.016 V/s)
-  ChainConfig cfg = rig_config();
-  cfg.amplitude_setpoint_v = 0.05;
-  cfg.ring_up_theta_rad = 10.0 * kDeg;
-  ChainRig<q31_t> rig(cfg);
-  rig.chain().set_excitation(true);
-  // WHEN the chain runs
-  double handover_s = -1.0;
-  rig.run(12.0, [&] {
-    if (handover_s < 0.0 && !rig.out().ring_up) handover_s = rig.time_s();
-  });
-  // THEN the direct drive brought the wave to 0.9 a_set (at ~2.8 s, ideal
-  // 0.045 V / 0.0159 V/s), the pump (growth up to k 10^2 / 8w - nu = 0.032/s)
-  // took it to the set point and holds it there along the commanded angle
-  std::printf("\n  ring-up from rest to 0.9 a_set: %.3f s; a_A %.6f V\n", handover_s,
-              rig.out().wave.a_A);
-  CHECK(handover_s > 2.5 && handover_s < 3.5);
-  DOUBLES_EQUAL(0.05, rig.out().wave.a_A, 0.05 * 1e-4);
-  DOUBLES_EQUAL(10.0 * kDeg, rig.out().theta_A_rad, 1e-3);
-  CHECK(rig.out().locked);
+  for (double a_set : {0.05, 1.0}) {
+    // GIVEN the resonator at rest. The 5 V forcer drive raises a_A by
+    // g u / 2w = 0.0159 V/s and the pump at its 10 V limit adds the growth
+    // rate k 10^2 / 8w - nu = 0.0318 1/s once there is a wave:
+    // a(t) = (0.0159 / 0.0318)(e^{0.0318 t} - 1) reaches 0.9 a_set at
+    // t = ln(1 + 0.9 a_set / 0.5) / 0.0318 (2.7 s for 0.05 V, 32 s for 1 V).
+    ChainConfig cfg = rig_config();
+    cfg.amplitude_setpoint_v = a_set;
+    cfg.ring_up_theta_rad = 10.0 * kDeg;
+    ChainRig<q31_t> rig(cfg);
+    rig.chain().set_excitation(true);
+    // WHEN the chain runs
+    double handover_s = -1.0;
+    rig.run(a_set < 0.5 ? 12.0 : 45.0, [&] {
+      if (handover_s < 0.0 && !rig.out().ring_up) handover_s = rig.time_s();
+    });
+    // THEN the handover to the pump comes when predicted and the pump holds
+    // the wave at the set point along the commanded angle
+    const double predicted_s = std::log(1.0 + 0.9 * a_set / 0.5) / 0.0318;
+    std::printf("\n  ring-up from rest to 0.9 x %.2f V: %.2f s (predicted %.2f s); a_A %.6f V\n",
+                a_set, handover_s, predicted_s, rig.out().wave.a_A);
+    DOUBLES_EQUAL(predicted_s, handover_s, 0.05 * predicted_s);
+    DOUBLES_EQUAL(a_set, rig.out().wave.a_A, a_set * 1e-4);
+    // (once rung up the pattern is free: the damping drift nu dmu sin4theta / 2
+    // moves it by up to 7.9e-5 rad/s, 3.5e-3 rad over 45 s)
+    const double t_run = a_set < 0.5 ? 12.0 : 45.0;
+    DOUBLES_EQUAL(10.0 * kDeg, rig.out().theta_A_rad, 7.9e-5 * t_run);
+    DOUBLES_EQUAL(true_wave(rig.resonator()).theta_A_rad, rig.out().wave.theta_A_rad, 1e-5);
+    CHECK(rig.out().locked);
+  }
 }
 
 TEST(ClosedLoop, PatternFollowsTheInputRateWithAllLoopsClosed) {
