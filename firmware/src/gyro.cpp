@@ -147,11 +147,16 @@ void Gyro::task_supervise(Gyro& g) {
   }
 
   // Window schedule; a host pattern command has priority over the scheduler's.
-  EstimatorHealth health = g.identifier_.health();
-  if (!g.cfg_.identify) health = {true, 1.0, 1.0};  // nothing to identify: never schedule
-  const WindowDecision d =
-      g.scheduler_.step(g.mode_.mode(), g.output_.theta_unwrapped_rad(),
-                        g.output_.rate_rad_s() * -g.cfg_.angular_gain / 2.0, health);
+  // Without identification there are no windows (the scheduler still counts
+  // frames for the duty figure).
+  WindowDecision d;
+  if (g.cfg_.identify) {
+    d = g.scheduler_.step(g.mode_.mode(), g.output_.theta_unwrapped_rad(),
+                          g.output_.rate_rad_s() * -g.cfg_.angular_gain / 2.0,
+                          g.identifier_.health());
+  } else {
+    (void)g.scheduler_.step(Mode::power_up, 0.0, 0.0, {});
+  }
   const bool operating = g.mode_.mode() == Mode::operate;
   g.commands_.pattern_control = operating && (g.host_pattern_ || d.pattern_command);
   g.commands_.pattern_target_rad =
@@ -195,7 +200,9 @@ void Gyro::task_output(Gyro& g) {
   // The model is applied once the campaign has ended (conditioning and
   // coverage good): an early solution from a few windows at nearby angles
   // would add more error than it removes.
-  if (g.scheduler_.campaign_done()) g.compensation_ready_ = true;
+  if (g.cfg_.identify ? g.scheduler_.campaign_done() : g.identifier_.health().solved) {
+    g.compensation_ready_ = true;
+  }
   const double drift = g.cfg_.compensate_drift && g.compensation_ready_
                            ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio)
                            : 0.0;

@@ -118,7 +118,8 @@ TEST(Gyro, TheIdentifiedDriftIsAddedToTheOutput) {
   Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
   CHECK(run_until(g, Mode::operate) > 0);
   const double a0 = g.status().out_angle_rad;
-  ident.drift = 1e-3;  // rad/s, Omega K units
+  ident.drift = 1e-3;  // rad/s, Omega K units (a model from calibration)
+  ident.health_.solved = true;
   run(g, 1000);
   DOUBLES_EQUAL(1e-3 / 0.5 * 1.0, g.status().out_angle_rad - a0, 1e-9);
 }

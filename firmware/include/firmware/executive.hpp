@@ -164,7 +164,10 @@ class Executive {
   void pace_frame() {
     const hal::Status st = pace_.sleep_until_ns(next_deadline_ns_);
     const uint64_t now = pace_.now_ns();
-    if (st == hal::Status::timeout || now > next_deadline_ns_ + period_ns_) {
+    // Frame 0's deadline is the start time itself: reading the clock has
+    // already passed it, which is no miss.
+    const bool late = st == hal::Status::timeout || now > next_deadline_ns_ + period_ns_;
+    if (late && frame_.frames > 0) {
       ++frame_.deadline_misses;
       if (now > next_deadline_ns_) {
         const uint64_t late_periods = (now - next_deadline_ns_) / period_ns_;

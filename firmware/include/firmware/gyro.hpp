@@ -25,8 +25,8 @@ struct GyroConfig {
   uint32_t settle_frames = 200;      // lock: frames inside the bands before operate
   uint32_t reacquire_frames = 10;    // recover: frames inside the bands before operate
   uint32_t fault_hold_frames = 500;  // fault: clean frames before a retry
-  bool compensate_drift = true;      // add the identified drift to the output
-  bool identify = true;              // run the interval shutdown schedule
+  bool compensate_drift = true;      // add the drift model (after the window campaign)
+  bool identify = true;              // run the windows (off: use the model it has)
   WindowConfig windows{};
   MonitorConfig monitor{};
 };

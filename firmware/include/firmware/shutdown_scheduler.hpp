@@ -17,7 +17,7 @@ struct WindowConfig {
   uint32_t max_wait_frames = 5000;     // open anyway after this long (a bin may never be reached)
   uint32_t bins = 16;                  // 4 theta_A bins over the full circle (<= kMaxBins)
   uint32_t windows_per_bin = 4;        // cap: the campaign ends when every bin holds this many
-  uint32_t min_windows_per_bin = 1;    // the estimator's word counts once every bin has this many
+  uint32_t min_windows_per_bin = 0;    // the estimator's word counts once every bin has this many
   double condition_good = 1.0e4;       // estimator condition number that ends the campaign
   double coverage_good = 0.9;          // estimator coverage (0..1) that ends the campaign
   bool rotate_on_static_base = true;   // command the pattern angle to fill empty bins

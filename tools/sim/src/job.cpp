@@ -10,6 +10,8 @@
 #include "can/candump_log.hpp"
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/estimator_port.hpp"
+#include "hal/linux/linux_clock.hpp"
+#include "hal/linux/realtime.hpp"
 #include "sim_target/control.hpp"
 #include "sim_tools/console.hpp"
 
@@ -271,18 +273,37 @@ void analyse(JobResult& r, const JobConfig& job) {
 
 }  // namespace
 
-JobResult run_job(const JobConfig& job, bool progress, const std::string& can_log) {
+JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   JobResult r;
+  const bool progress = opt.progress;
+  const std::string& can_log = opt.can_log;
   if (const char* err = dsp::check_chain_config(job.chain)) throw std::invalid_argument(err);
   sim::SimTarget& target = sim::target();
   target.configure(job.sim);
-  HostClock timer;
   fw::DspChainPort chain(job.chain);
   fw::EstimatorPort ident(job.estimator);
+  // Lockstep: the board's simulated clock paces (it returns at once) and a
+  // host clock times the tasks. Real time: CLOCK_MONOTONIC does both, with
+  // the simulated converters behind it.
+  HostClock host_timer;
+  hal::linux_board::LinuxClock rt_clock;
+  hal::Board& sim_board = target.board();
+  hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
+                      sim_board.fault_input, sim_board.can, rt_clock};
+  r.real_time = opt.real_time;
+  if (opt.real_time) {
+    hal::linux_board::RealtimeRequest req;
+    req.priority = opt.rt_priority;
+    char buf[200];
+    r.realtime_setup =
+        hal::linux_board::describe(hal::linux_board::setup_realtime(req), buf, sizeof buf);
+  }
   // The firmware objects are large (the chain holds its filters): on the heap
   // here, statically allocated on a board.
-  auto gyro = std::make_unique<fw::Gyro>(target.board(), chain, ident, timer, fw::Pacing::lockstep,
-                                         job.gyro);
+  auto gyro = opt.real_time ? std::make_unique<fw::Gyro>(rt_board, chain, ident, rt_clock,
+                                                         fw::Pacing::real_time, job.gyro)
+                            : std::make_unique<fw::Gyro>(sim_board, chain, ident, host_timer,
+                                                         fw::Pacing::lockstep, job.gyro);
   if (!gyro->board_ok())
     throw std::invalid_argument(
         "the simulated board's converters do not "

@@ -127,6 +127,8 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.end_object();
 
   w.begin_object("executive");
+  w.string("pacing", r.real_time ? "real_time" : "lockstep");
+  if (r.real_time) w.string("realtime_setup", r.realtime_setup);
   w.integer("frames", static_cast<long long>(r.frames.frames));
   w.integer("missed_frames", r.frames.missed_frames);
   w.integer("deadline_misses", r.frames.deadline_misses);
@@ -274,13 +276,18 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   bias.row({"parked angles", fmt("%zu", r.parks.size())});
   bias.print(out);
 
-  TextTable ex("executive (lockstep; host time per task)");
+  TextTable ex(r.real_time ? "executive (real time: " + r.realtime_setup + ")"
+                           : std::string("executive (lockstep; host time per task)"));
   ex.row({"task", "rate", "budget", "max", "mean", "overruns", "slips"});
   for (const auto& t : r.tasks) {
     ex.row({t.name, fmt("%u Hz", t.rate_hz), fmt("%.0f us", t.budget_ns / 1e3),
             fmt("%.1f us", t.max_ns / 1e3), fmt("%.2f us", t.mean_ns / 1e3), fmt("%u", t.overruns),
             fmt("%u", t.slips)});
   }
+  ex.row({"frames", fmt("%llu", static_cast<unsigned long long>(r.frames.frames)),
+          fmt("missed %u", r.frames.missed_frames),
+          fmt("deadline misses %u", r.frames.deadline_misses),
+          fmt("max frame %.1f us", r.frames.max_frame_ns / 1e3)});
   ex.print(out);
   if (r.failures.empty()) {
     std::fprintf(out, "result: PASS\n");

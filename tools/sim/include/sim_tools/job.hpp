@@ -111,12 +111,22 @@ struct JobResult {
   std::vector<TaskFigures> tasks;
   fw::FrameStats frames{};
   uint64_t can_frames = 0;
+  bool real_time = false;
+  std::string realtime_setup;         // what SCHED_FIFO / mlockall gave (real time only)
   std::vector<std::string> failures;  // empty: the run passed
 };
 
-// Runs firmware + simulated target in lockstep. `progress` draws a bar on
-// stderr; `can_log` (when not empty) receives every CAN frame as a candump log.
-JobResult run_job(const JobConfig& job, bool progress, const std::string& can_log);
+struct RunOptions {
+  bool progress = false;   // a bar on stderr
+  std::string can_log;     // when not empty: every CAN frame as a candump log
+  bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
+  int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
+};
+
+// Runs firmware + simulated target: in lockstep (as fast as the host allows,
+// deterministic) or paced in real time with the same executive code, where
+// deadline misses are counted and the real-time setup is reported.
+JobResult run_job(const JobConfig& job, const RunOptions& options);
 
 // The true drift D (rad/s, Omega K units) of the resonator at pattern angle
 // theta with quadrature ratio a_B/a_A (physics.md section 3, D_nu + D_w).
