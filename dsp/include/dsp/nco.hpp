@@ -89,7 +89,7 @@ struct SineTable {
 // Rounding (Q1.31): interpolation to nearest, ties toward +inf. Overflow: none
 // (the result lies between two table entries).
 template <typename T>
-inline T sin_turns(uint32_t phase) {
+HRG_DSP_INLINE T sin_turns(uint32_t phase) {
   const auto& t = SineTable<T>::kValues;
   const uint32_t i = phase >> kSineFracBits;
   const uint32_t frac = phase & ((uint32_t{1} << kSineFracBits) - 1u);
@@ -106,7 +106,7 @@ inline T sin_turns(uint32_t phase) {
 
 // cos(2 pi phase / 2^32), same contract as sin_turns.
 template <typename T>
-inline T cos_turns(uint32_t phase) {
+HRG_DSP_INLINE T cos_turns(uint32_t phase) {
   return sin_turns<T>(phase + (uint32_t{1} << 30));
 }
 
