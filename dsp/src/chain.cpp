@@ -22,6 +22,14 @@ const char* check_chain_config(const ChainConfig& c) {
   if (!(c.f_min_hz > 0.0 && c.f_min_hz <= c.f_center_hz && c.f_center_hz <= c.f_max_hz &&
         c.f_max_hz < c.sample_rate_hz / 2.0))
     return "chain config: need 0 < f_min_hz <= f_center_hz <= f_max_hz < sample_rate_hz / 2";
+  // Periodicity rule: the block must span (nearly) whole half-periods of 2f
+  // over the whole PLL range, or the 2f image leaks through the decimator.
+  for (int k = 0; k <= 8; ++k) {
+    const double f = c.f_min_hz + (c.f_max_hz - c.f_min_hz) * k / 8.0;
+    if (image_rejection_db(2.0 * f, c.sample_rate_hz, c.block_frames) > -100.0)
+      return "chain config: block_frames breaks the periodicity rule over [f_min_hz, f_max_hz]: "
+             "the 2f image would be rejected by less than 100 dB";
+  }
   if (!(c.q_factor > 0.0)) return "chain config: q_factor must be > 0";
   if (!(c.pump_gain_per_s2_v2 > 0.0)) return "chain config: pump_gain_per_s2_v2 must be > 0";
   if (!(c.forcer_gain_per_s2 > 0.0)) return "chain config: forcer_gain_per_s2 must be > 0";

@@ -42,6 +42,17 @@ TEST(ChainConfig, DefaultsAreUsableAndBadFieldsAreNamed) {
   c = ChainConfig{};
   c.ring_up_exit = 0.05;
   STRCMP_CONTAINS("ring_up", check_chain_config(c));
+  // a resonance 300 Hz off the periodicity rule of the 100-frame block:
+  // 2f = 10.6 kHz is only 92 dB down (image_rejection_db)
+  c = ChainConfig{};
+  c.f_min_hz = 5290.0;
+  c.f_center_hz = 5300.0;
+  c.f_max_hz = 5310.0;
+  STRCMP_CONTAINS("periodicity rule", check_chain_config(c));
+  // the same resonance with 1000-frame blocks (53 whole periods, zeros every
+  // 100 Hz) satisfies the rule
+  c.block_frames = 1000;
+  CHECK(check_chain_config(c) == nullptr);
 }
 
 TEST(ChainConfig, AnUnusableConfigurationMakesProcessRefuse) {
