@@ -63,7 +63,10 @@ void Resonator::set_effects(const Effects& fx) {
 }
 void Resonator::set_rate_profile(Profile rate_rad_s) { rate_ = std::move(rate_rad_s); }
 void Resonator::set_temperature_profile(Profile temp_c) { temp_ = std::move(temp_c); }
-void Resonator::set_reference_hz(double f_hz) { f_ref_hz_ = f_hz; }
+void Resonator::set_reference_hz(double f_hz) {
+  f_ref_hz_ = f_hz;
+  dt_last_ = -1.0;  // recompute the <V^2> window at the next step
+}
 
 double Resonator::omega_rad_s() const {
   return detail::thermal_omega(params_, effects_, temperature_c());
@@ -240,7 +243,7 @@ PickoffOutput Resonator::measured() const {
   if (effects_.drive_feedthrough.enabled) {
     // c V e^{i psi}: Re(Vc e^{i psi} e^{iwt}) = cos psi V(t) - sin psi V(t - T/4).
     const auto& ft = effects_.drive_feedthrough;
-    const double quarter = 1.0 / (4.0 * f_ref_hz_ * dt_last_);
+    const double quarter = std::min(kHistory - 2.0, 1.0 / (4.0 * f_ref_hz_ * std::abs(dt_last_)));
     const double v_now = pump_hist_[hist_pos_];
     const double v_lag = pump_delayed(quarter);
     const double px = ft.x_phase_deg * kDegToRad;
