@@ -200,39 +200,70 @@ TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
   }
 }
 
+namespace {
+// Time at which a sampled angle history first passes `level` (linear
+// interpolation between blocks), or -1.
+struct Crossing {
+  double level;
+  double dir;  // -1: falling through level, +1: rising
+  double t_s = -1.0;
+  void feed(double t_prev, double th_prev, double t, double th) {
+    if (t_s >= 0.0 || (th - level) * dir < 0.0) return;
+    t_s = t_prev + (t - t_prev) * (level - th_prev) / (th - th_prev);
+  }
+};
+}  // namespace
+
 TEST(ClosedLoop, PatternFollowsTheInputRateWithAllLoopsClosed) {
-  // GIVEN 100 deg/s about the sensitive axis and all loops closed
-  const double omega = 100.0 * kDeg;
-  const hrg::sim::ResonatorParams rp;
-  ChainRig<q31_t> rig(rig_config(), rp);
-  rig.resonator().set_rate_profile(hrg::sim::Profile::constant(omega));
-  rig.resonator().set_standing_wave(1.0, 0.1);
-  rig.chain().set_excitation(true);
-  rig.run(1.0);
-  // WHEN theta_A is followed over exactly 3 periods of 4 theta (3 pi/2 rad of
-  // pattern angle), start and end interpolated between blocks
-  const double expected = -rp.angular_gain * omega / 2.0;
-  const double th0 = rig.out().theta_A_rad - 0.01;
-  const double th1 = th0 - 3.0 * kPi / 2.0;
-  double t0 = -1, t1 = -1, prev_t = rig.time_s(), prev_th = rig.out().theta_A_rad;
-  double worst_a = 0.0, worst_q = 0.0;
-  rig.run(12.0, [&] {
-    const double t = rig.time_s(), th = rig.out().theta_A_rad;
-    if (t0 < 0 && th <= th0) t0 = prev_t + (t - prev_t) * (th0 - prev_th) / (th - prev_th);
-    if (t1 < 0 && th <= th1) t1 = prev_t + (t - prev_t) * (th1 - prev_th) / (th - prev_th);
-    worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
-    worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
-    prev_t = t;
-    prev_th = th;
-  });
-  CHECK(t0 > 0 && t1 > t0);
-  const double rate = (th1 - th0) / (t1 - t0);
-  // THEN the mean rate is -K Omega / 2 within 1e-5 relative
+  double worst_rel = 0.0, worst_true_rel = 0.0, worst_a = 0.0, worst_q = 0.0;
+  for (double rate_dps : {100.0, -100.0}) {
+    for (double theta0 : {0.1, 0.5}) {
+      // GIVEN +-100 deg/s about the sensitive axis and all loops closed
+      const double omega = rate_dps * kDeg;
+      const hrg::sim::ResonatorParams rp;
+      ChainRig<q31_t> rig(rig_config(), rp);
+      rig.resonator().set_rate_profile(hrg::sim::Profile::constant(omega));
+      rig.resonator().set_standing_wave(1.0, theta0);
+      rig.chain().set_excitation(true);
+      ThetaUnwrapper<double> true_theta;
+      rig.run(1.0, [&] { true_theta.update(true_wave(rig.resonator()).theta_A_rad); });
+      // WHEN theta_A (measured, and the resonator's own) is followed over
+      // exactly 3 periods of 4 theta (3 pi/2 rad of pattern angle)
+      const double expected = -rp.angular_gain * omega / 2.0;
+      const double dir = expected > 0.0 ? 1.0 : -1.0;
+      const double m0 = rig.out().theta_A_rad + 0.01 * dir;
+      const double r0 = true_theta.value() + 0.01 * dir;
+      Crossing cm0{m0, dir}, cm1{m0 + dir * 3.0 * kPi / 2.0, dir};
+      Crossing cr0{r0, dir}, cr1{r0 + dir * 3.0 * kPi / 2.0, dir};
+      double prev_t = rig.time_s(), prev_m = rig.out().theta_A_rad, prev_r = true_theta.value();
+      rig.run(11.0, [&] {
+        const double t = rig.time_s(), m = rig.out().theta_A_rad;
+        const double r = true_theta.update(true_wave(rig.resonator()).theta_A_rad);
+        cm0.feed(prev_t, prev_m, t, m);
+        cm1.feed(prev_t, prev_m, t, m);
+        cr0.feed(prev_t, prev_r, t, r);
+        cr1.feed(prev_t, prev_r, t, r);
+        worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
+        worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
+        prev_t = t;
+        prev_m = m;
+        prev_r = r;
+      });
+      CHECK(cm0.t_s > 0 && cm1.t_s > cm0.t_s && cr0.t_s > 0 && cr1.t_s > cr0.t_s);
+      const double rate = (cm1.level - cm0.level) / (cm1.t_s - cm0.t_s);
+      const double true_rate = (cr1.level - cr0.level) / (cr1.t_s - cr0.t_s);
+      // THEN the mean rate is -K Omega / 2 within 1e-5 relative
+      DOUBLES_EQUAL(expected, rate, 1e-5 * std::fabs(expected));
+      DOUBLES_EQUAL(expected, true_rate, 1e-5 * std::fabs(expected));
+      worst_rel = std::fmax(worst_rel, std::fabs(rate / expected - 1.0));
+      worst_true_rel = std::fmax(worst_true_rel, std::fabs(true_rate / expected - 1.0));
+    }
+  }
   std::printf(
-      "\n  100 deg/s: theta_A' = %.8f rad/s, -K Omega/2 = %.8f, rel. error %.2e; "
-      "|a_A - 1| %.1e, |a_B| %.1e\n",
-      rate, expected, rate / expected - 1.0, worst_a, worst_q);
-  DOUBLES_EQUAL(expected, rate, 1e-5 * std::fabs(expected));
+      "\n  +-100 deg/s: theta_A' vs -K Omega/2: rel. error %.1e measured, %.1e true; "
+      "|a_A - 1| %.1e, |a_B| %.1e V\n",
+      worst_rel, worst_true_rel, worst_a, worst_q);
+  // and the loops hold while the pattern turns
   CHECK(worst_a < 1e-4);
   CHECK(worst_q < 1e-4);
 }
