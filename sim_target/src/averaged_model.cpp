@@ -206,33 +206,49 @@ AveragedModel::Mat5 AveragedModel::system_matrix(double t_s, const Vec5& r) cons
   return a;
 }
 
+void AveragedModel::step(double h, bool state_dep, bool inputs_vary) {
+  if (state_dep) {
+    const Mat5 a0 = system_matrix(t_s_, r_);
+    const Vec5 r_mid = detail::expm<Mat5>(a0 * (0.5 * h)) * r_;
+    const Mat5 a_mid = system_matrix(t_s_ + 0.5 * h, r_mid);
+    r_ = detail::expm<Mat5>(a_mid * h) * r_;
+  } else if (!inputs_vary && !dirty_ && h == cached_h_ && rate_.is_constant() &&
+             temp_.is_constant()) {
+    r_ = cached_phi_ * r_;  // constant system, same step: the cached propagator is exact
+  } else {
+    const Mat5 ah = system_matrix(t_s_ + 0.5 * h, r_) * h;
+    if (ah != cached_ah_) {
+      cached_ah_ = ah;
+      cached_phi_ = detail::expm<Mat5>(ah);
+    }
+    cached_h_ = h;
+    dirty_ = false;
+    r_ = cached_phi_ * r_;
+  }
+  r_(4) = 1.0;
+}
+
 void AveragedModel::advance(double dt_s) {
   if (!(dt_s > 0.0)) return;
+  const double t_end = t_s_ + dt_s;
   const bool state_dep = state_dependent();
-  const bool time_dep = !rate_.is_constant() || !temp_.is_constant();
-  int steps = 1;
-  if (state_dep || time_dep) steps = std::max(1, static_cast<int>(std::ceil(dt_s / max_step_s_)));
-  const double h = dt_s / steps;
-  for (int i = 0; i < steps; ++i) {
-    if (state_dep) {
-      const Mat5 a0 = system_matrix(t_s_, r_);
-      const Vec5 r_mid = detail::expm<Mat5>(a0 * (0.5 * h)) * r_;
-      const Mat5 a_mid = system_matrix(t_s_ + 0.5 * h, r_mid);
-      r_ = detail::expm<Mat5>(a_mid * h) * r_;
-    } else if (!time_dep && !dirty_ && h == cached_h_) {
-      r_ = cached_phi_ * r_;  // constant system, same step: the cached propagator is exact
-    } else {
-      const Mat5 ah = system_matrix(t_s_ + 0.5 * h, r_) * h;
-      if (ah != cached_ah_) {
-        cached_ah_ = ah;
-        cached_phi_ = detail::expm<Mat5>(ah);
-      }
-      cached_h_ = h;
-      dirty_ = false;
-      r_ = cached_phi_ * r_;
+  // Segments end at the profiles' corners (rate steps, ramp knees), so a step
+  // never straddles a jump; within a segment, inputs that still vary (ramps,
+  // sines) or amplitude-dependent terms take midpoint steps of at most max_step_s.
+  while (t_s_ < t_end) {
+    double seg_end =
+        std::min({t_end, rate_.next_breakpoint_s(t_s_), temp_.next_breakpoint_s(t_s_)});
+    if (!(seg_end > t_s_)) seg_end = t_end;
+    const bool vary = rate_.varies_between(t_s_, seg_end) || temp_.varies_between(t_s_, seg_end);
+    const double span = seg_end - t_s_;
+    const int steps =
+        (state_dep || vary) ? std::max(1, static_cast<int>(std::ceil(span / max_step_s_))) : 1;
+    const double h = span / steps;
+    for (int i = 0; i < steps; ++i) {
+      step(h, state_dep, vary);
+      t_s_ += h;
     }
-    r_(4) = 1.0;
-    t_s_ += h;
+    t_s_ = seg_end;
   }
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -91,6 +92,23 @@ Profile Profile::table_file(const std::string& path, double scale) {
   }
   if (points.empty()) throw std::runtime_error(path + ": profile table has no rows");
   return ramps(std::move(points));
+}
+
+double Profile::next_breakpoint_s(double t_s) const {
+  if (kind_ != Kind::steps && kind_ != Kind::ramps) return std::numeric_limits<double>::infinity();
+  auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
+                             [](double t, const ProfilePoint& p) { return t < p.t_s; });
+  return it == points_.end() ? std::numeric_limits<double>::infinity() : it->t_s;
+}
+
+bool Profile::varies_between(double t0_s, double t1_s) const {
+  switch (kind_) {
+    case Kind::constant:
+    case Kind::steps: return false;
+    case Kind::sine: return amplitude_ != 0.0;
+    case Kind::ramps: return value(t0_s) != value(t1_s);
+  }
+  return true;
 }
 
 double Profile::value(double t_s) const {

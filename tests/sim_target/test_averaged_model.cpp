@@ -127,3 +127,19 @@ TEST(AveragedModel, NonlinearDampingScalesTheDecayWithEnergy) {
   const double rate = -std::log(m.wave().a_a_v / 2.0) / 0.01;
   DOUBLES_EQUAL(p.nu_per_s() * (1.0 + 0.1 * 4.0), rate, 1e-4 * rate);
 }
+
+TEST(AveragedModel, RateStepsAreAppliedAtTheirExactTimes) {
+  // GIVEN an isotropic resonator and a rate step of 10 deg/s at t = 0.0123 s
+  ResonatorParams p;
+  p.dmu = 0.0;
+  p.split_hz = 0.0;
+  AveragedModel m(p);
+  const double rate = 10.0 * kDegToRad;
+  m.set_rate_profile(Profile::steps({{0.0, 0.0}, {0.0123, rate}}));
+  m.set_standing_wave(1.0, 0.0);
+  // WHEN advanced in 10 ms outputs (the step falls inside the second one)
+  for (int i = 0; i < 5; ++i)
+    m.advance(0.01);
+  // THEN the angle is -K Omega/2 times the exact time since the step
+  DOUBLES_EQUAL(-p.angular_gain * rate / 2.0 * (0.05 - 0.0123), m.wave().theta_rad, 1e-12);
+}

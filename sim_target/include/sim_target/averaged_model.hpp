@@ -20,7 +20,9 @@
 // time-varying profiles the coefficients are taken at the step's midpoint
 // (second order); with amplitude- or phase-dependent terms (Duffing, nonlinear
 // damping, drive phase following the wave) at a predicted midpoint state.
-// Steps are at most max_step_s (default 0.01 s) in those cases.
+// Steps are at most max_step_s (default 0.01 s) in those cases. Steps never
+// straddle a corner of a profile (a rate step is applied at its exact time),
+// and a stepwise-constant profile costs one exact step per segment.
 //
 // Not thread-safe; cheap to copy (Monte Carlo copies one per run).
 
@@ -138,6 +140,7 @@ class AveragedModel {
   using Vec5 = Eigen::Matrix<double, 5, 1>;
 
   Mat5 system_matrix(double t_s, const Vec5& r) const;
+  void step(double h, bool state_dep, bool inputs_vary);
   bool state_dependent() const;
 
   ResonatorParams params_;

@@ -41,6 +41,12 @@ class Profile {
   }
 
   double value(double t_s) const;
+  // The first time after t_s where the profile has a corner (steps: a jump;
+  // ramps: a change of slope), +infinity if none. Integrators stop there.
+  double next_breakpoint_s(double t_s) const;
+  // True when the value changes somewhere in (t0_s, t1_s) without a breakpoint
+  // in between (a ramp's slope, a sine).
+  bool varies_between(double t0_s, double t1_s) const;
   // True when value() does not depend on time.
   bool is_constant() const {
     return kind_ == Kind::constant || (kind_ == Kind::sine && amplitude_ == 0.0);
