@@ -94,6 +94,30 @@ Profile Profile::table_file(const std::string& path, double scale) {
   return ramps(std::move(points));
 }
 
+double Profile::integral(double t0_s, double t1_s) const {
+  if (kind_ == Kind::constant) return offset_ * (t1_s - t0_s);
+  if (kind_ == Kind::sine) {
+    const double w = 2.0 * std::numbers::pi * freq_hz_;
+    const double base = offset_ * (t1_s - t0_s);
+    if (w == 0.0) return base + amplitude_ * std::sin(phase_rad_) * (t1_s - t0_s);
+    return base +
+           amplitude_ / w * (std::cos(w * t0_s + phase_rad_) - std::cos(w * t1_s + phase_rad_));
+  }
+  // Piecewise: constant (steps) or linear (ramps) between corners.
+  double sum = 0.0;
+  double t = t0_s;
+  while (t < t1_s) {
+    const double e = std::min(t1_s, next_breakpoint_s(t));
+    if (kind_ == Kind::steps) {
+      sum += value(0.5 * (t + e)) * (e - t);
+    } else {
+      sum += 0.5 * (value(t) + value(e)) * (e - t);
+    }
+    t = e;
+  }
+  return sum;
+}
+
 double Profile::next_breakpoint_s(double t_s) const {
   if (kind_ != Kind::steps && kind_ != Kind::ramps) return std::numeric_limits<double>::infinity();
   auto it = std::upper_bound(points_.begin(), points_.end(), t_s,

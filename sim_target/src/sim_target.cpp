@@ -171,11 +171,9 @@ Status SimTarget::produce_block(std::span<hal::sample_q31> frames, uint64_t& t_f
     ++sample_index_;
     if (burst_left_s_ > 0.0) burst_left_s_ -= dt;
   }
-  // Input angle: Simpson's rule over the block; pattern angle unwrapped per block.
+  // Input angle: the exact integral of the rate profile over the block.
   const double t1 = time_s();
-  const Profile& rate = config_.rate_rad_s;
-  input_angle_rad_ +=
-      (t1 - t0) / 6.0 * (rate.value(t0) + 4.0 * rate.value(0.5 * (t0 + t1)) + rate.value(t1));
+  input_angle_rad_ += config_.rate_rad_s.integral(t0, t1);
   cplx x;
   cplx y;
   resonator_.envelopes(x, y);

@@ -60,3 +60,14 @@ TEST(Profile, TableFileIsReadScaledAndCheckedLineByLine) {
 TEST(Profile, RejectsTimesThatDoNotIncrease) {
   CHECK_THROWS(std::invalid_argument, Profile::ramps({{1.0, 0.0}, {1.0, 1.0}}));
 }
+
+TEST(Profile, IntegralIsExactForEveryKind) {
+  DOUBLES_EQUAL(6.0, Profile::constant(2.0).integral(1.0, 4.0), 1e-15);
+  // steps: 1 on [0, 2), 3 from 2 on -> over [1, 3]: 1 + 3
+  DOUBLES_EQUAL(4.0, Profile::steps({{0.0, 1.0}, {2.0, 3.0}}).integral(1.0, 3.0), 1e-15);
+  // ramps 0 -> 2 over [0, 2], then held: over [1, 3]: 1.5 + 2
+  DOUBLES_EQUAL(3.5, Profile::ramps({{0.0, 0.0}, {2.0, 2.0}}).integral(1.0, 3.0), 1e-15);
+  // sine: integral of sin(2 pi t) over [0, 0.25] = 1 / (2 pi)
+  DOUBLES_EQUAL(1.0 / (2.0 * std::acos(-1.0)), Profile::sine(1.0, 1.0, 0.0).integral(0.0, 0.25),
+                1e-15);
+}

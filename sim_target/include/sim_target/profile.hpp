@@ -41,6 +41,8 @@ class Profile {
   }
 
   double value(double t_s) const;
+  // Exact integral of the profile over [t0_s, t1_s] (e.g. the input angle).
+  double integral(double t0_s, double t1_s) const;
   // The first time after t_s where the profile has a corner (steps: a jump;
   // ramps: a change of slope), +infinity if none. Integrators stop there.
   double next_breakpoint_s(double t_s) const;
