@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include <estimator/drift.hpp>
 
+#include <Eigen/Cholesky>
 #include <cmath>
+
+#include <estimator/conditioning.hpp>
 
 namespace hrg::est {
 
@@ -95,6 +98,88 @@ bool ControlDriftEstimator::add_sample(const Sample& s) {
   prev_ = b;
   have_prev_ = true;
   return true;
+}
+
+void PumpDriftEstimator::fold_segment() {
+  if (seg_blocks_ >= 3) {
+    Mat4 c = seg_s_ - seg_sum_ * seg_sum_.transpose() / seg_blocks_;
+    double decay = 1.0;
+    if (config_.forgetting_time_s > 0 && have_fold_)
+      decay = std::exp(-(t_last_s_ - t_last_fold_s_) / config_.forgetting_time_s);
+    m_ = decay * m_ + c * static_cast<double>(config_.block_samples);
+    fit_s_ = decay * fit_s_ + (t_last_s_ - t0_s_);
+    t_last_fold_s_ = t_last_s_;
+    have_fold_ = true;
+  }
+  started_ = false;
+  seg_s_.setZero();
+  seg_sum_.setZero();
+  seg_blocks_ = 0;
+  block_.setZero();
+  in_block_ = 0;
+}
+
+void PumpDriftEstimator::restart() { fold_segment(); }
+
+bool PumpDriftEstimator::add_sample(const Sample& s) {
+  if (!std::isfinite(s.t_s) || !std::isfinite(s.a_A_v) || !(s.a_A_v > 0) ||
+      !std::isfinite(s.a_B_v) || !std::isfinite(s.theta_A_rad) || !std::isfinite(s.pump_v) ||
+      !(s.pump_v > 0) || !std::isfinite(s.pump_phase_error_rad) ||
+      (started_ && !(s.t_s > t_last_s_ && s.t_s - t_last_s_ <= config_.max_sample_gap_s))) {
+    fold_segment();
+    return false;
+  }
+  const double c4 = std::cos(4.0 * s.theta_A_rad);
+  const double s4 = std::sin(4.0 * s.theta_A_rad);
+  const double w = s.pump_v * s.pump_v * std::cos(s.pump_phase_error_rad);
+  w_last_ = w;
+  const double dnu = p_(kDnuC) * c4 + p_(kDnuS) * s4;
+  const double g = p_(kDwC) * s4 - p_(kDwS) * c4;
+  // Integrands: the three pump regressors and the known decay rate.
+  const Vec4 h(w, w * c4, w * s4, p_(kNu) + dnu + g * s.a_B_v / s.a_A_v);
+  const double ln_a = std::log(s.a_A_v);
+  if (!started_) {
+    started_ = true;
+    t0_s_ = t_last_s_ = s.t_s;
+    ln_a0_ = ln_a;
+    z_.setZero();
+  } else {
+    z_ += 0.5 * (s.t_s - t_last_s_) * (h_prev_ + h);
+    t_last_s_ = s.t_s;
+  }
+  h_prev_ = h;
+  // Row: regressors I0..I2 and y = ln a - ln a0 + int known rate.
+  block_ += Vec4(z_(0), z_(1), z_(2), ln_a - ln_a0_ + z_(3));
+  if (++in_block_ == config_.block_samples) {
+    const Vec4 r = block_ / in_block_;
+    seg_s_ += r * r.transpose();
+    seg_sum_ += r;
+    ++seg_blocks_;
+    block_.setZero();
+    in_block_ = 0;
+  }
+  if (t_last_s_ - t0_s_ >= config_.segment_s && in_block_ == 0) fold_segment();
+  return true;
+}
+
+bool PumpDriftEstimator::valid() const {
+  if (fit_s_ < config_.min_fit_s) return false;
+  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  return conditioning_of<3>(n).kappa_2 <= config_.max_kappa_2;
+}
+
+Eigen::Vector3d PumpDriftEstimator::coefficients() const {
+  if (!valid()) return Eigen::Vector3d::Zero();
+  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  const Eigen::Vector3d b = m_.topRightCorner<3, 1>();
+  const Eigen::Vector3d s = n.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::Matrix3d a = s.asDiagonal() * n * s.asDiagonal();
+  return s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * b);
+}
+
+double PumpDriftEstimator::d_phi_rad_s(double theta_A_rad) const {
+  const Eigen::Vector3d c = coefficients();
+  return w_last_ * (c(2) * std::cos(4.0 * theta_A_rad) - c(1) * std::sin(4.0 * theta_A_rad));
 }
 
 }  // namespace hrg::est

@@ -10,6 +10,7 @@ Status Estimator::end_window() {
   if (s == Status::ok) ls_.add_window(scratch_);
   // The loops re-acquire after the window: the D_Phi derivatives restart.
   control_.restart();
+  pump_.restart();
   return s;
 }
 
@@ -18,13 +19,15 @@ Solution Estimator::solve_and_accept() {
   if (last_.accepted()) {
     comp_.set_model(last_.p);
     control_.set_model(last_.p);
+    pump_.set_model(last_.p);
   }
   return last_;
 }
 
 double Estimator::step_output(double theta_A_rad, double aB_over_aA, double dt_s,
                               bool excitation_on) {
-  const double d_phi = excitation_on && config_.compensate_control_drift ? d_phi_rad_s() : 0.0;
+  const double d_phi =
+      excitation_on && config_.compensate_control_drift ? d_phi_rad_s(theta_A_rad) : 0.0;
   return comp_.step(theta_A_rad, aB_over_aA, d_phi, dt_s);
 }
 

@@ -165,7 +165,7 @@ TEST(ControlDrift, EstimatorCompensatesDPhiWithExcitationOnOnly) {
     // in-phase forcer part cancels the split's quadrature growth: a_B stays 0
     est.add_control_sample({200.0 + i * 1e-3, 1.0, 0.0, th, 0.0, -g, qc});
   }
-  DOUBLES_EQUAL(-qc, est.d_phi_rad_s(), 1e-3 * qc);
+  DOUBLES_EQUAL(-qc, est.d_phi_rad_s(th), 1e-3 * qc);
   // WHEN the output is stepped for 1 s with and without excitation
   const double dnu_rate = est.drift_rate_rad_s(th, 0.0) / 0.554;
   const double c0 = est.correction_rad();

@@ -238,3 +238,109 @@ TEST(MonteCarlo, EstimatorBoundEqualsTheFisherInformationOfTheAmplitudes) {
     DOUBLES_EQUAL(1.0, crb(i, i) / crb_fisher(i, i), 0.01);
   }
 }
+
+TEST_GROUP(ControlDriftOnAveragedModel) {
+  sim::ResonatorParams rp;
+  ParamVector p;
+  void setup() override {
+    rp.th_mu_rad = 12 * sim::kDegToRad;
+    rp.th_w_rad = 31 * sim::kDegToRad;
+    p = truth_of(rp);
+  }
+  // D - (D_nu + D_w) of the model at rest, from the angle change over h.
+  double measured_d_phi(sim::AveragedModel & m, double th, double q) {
+    m.set_rate_profile(sim::Profile::constant(0.0));
+    m.set_standing_wave(1.0, th, q, 0.0);
+    const sim::WaveState w0 = m.wave();
+    const double h = 1e-4;
+    m.advance(h);
+    const double d = 2.0 * std::remainder(m.wave().theta_rad - w0.theta_rad, M_PI / 2) / h;
+    return d - resonator_drift_rad_s(p, th, w0.a_b_v / w0.a_a_v);
+  }
+};
+
+TEST(ControlDriftOnAveragedModel, PumpGapDriftIsIdentifiedFromThePumpEffortAndCompensated) {
+  // GIVEN a ring pump with a 4theta gap non-uniformity (eps_p 0.02, eps_q 0.01),
+  // locked 0.1 rad off its best phase (eps = pi/2 - 2 (phi_V - phi_A) = -0.2),
+  // the pattern precessing at 50 deg/s input rate for 60 s, noise as usual
+  sim::ElectrodeParams el;
+  el.eps_p = 0.02;
+  el.eps_q = 0.01;
+  const double delta = 0.1, eps = -2 * delta;
+  sim::AveragedModel m(rp, el);
+  m.set_standing_wave(1.0, 0.1, 0.0, 0.0);
+  m.set_rate_profile(sim::Profile::constant(50 * sim::kDegToRad));
+  sim::EnvelopeDrive dr;
+  dr.excitation = true;
+  dr.pump_v = el.threshold_v(rp.omega_rad_s(), rp.nu_per_s()) / std::sqrt(std::cos(2 * delta));
+  dr.pump_phase_rad = M_PI / 4 + delta;
+  m.set_drive(dr);
+  PumpDriftEstimator est;
+  est.set_model(p);
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 60000; ++i) {
+    m.advance(1e-3);
+    const WaveSample s = measure(m, kQuadratureNoiseV, rng);
+    CHECK(est.add_sample({s.t_s, s.a_A_v, s.a_B_v, s.theta_A_rad, eps, 0, 0, dr.pump_v}));
+  }
+  CHECK(est.valid());
+  // THEN the pump gain and the gap harmonics come out of the pump effort:
+  // c = k_pump / (8 w), b1/c = eps_p/2, b2/c = eps_q/2
+  const Eigen::Vector3d c = est.coefficients();
+  const double c_true = el.pump_gain_per_s2_v2 / (8 * rp.omega_rad_s());
+  DOUBLES_EQUAL(c_true, c(0), 1e-3 * c_true);
+  DOUBLES_EQUAL(0.01, c(1) / c(0), 2e-4);
+  DOUBLES_EQUAL(0.005, c(2) / c(0), 2e-4);
+  // AND D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th) matches the model's
+  // extra drift at 16 parked angles (q = 0) to 1 % of its amplitude, which the
+  // paper's eq. 29 (zero for equal phase errors) does not see at all
+  double worst = 0, amplitude = 0;
+  for (int k = 0; k < 16; ++k) {
+    const double th = 0.013 + k * (M_PI / 2) / 16;
+    const double truth = measured_d_phi(m, th, 0.0);
+    amplitude = std::max(amplitude, std::abs(truth));
+    worst = std::max(worst, std::abs(truth - est.d_phi_rad_s(th)));
+  }
+  std::printf("\nPump gap drift: amplitude %.3e rad/s, worst estimate error %.3e rad/s\n",
+              amplitude, worst);
+  CHECK(amplitude > 3e-5);
+  CHECK(worst < 0.01 * amplitude);
+}
+
+TEST(ControlDriftOnAveragedModel, DepumpedQuadratureWaveDriftFollowsEquation23) {
+  // GIVEN an ideal ring pump (no gap), 0.1 rad off its best phase, on an
+  // isotropic resonator, with a_B/a_A = 0.05: the parametric pump damps the
+  // quadrature wave B (dphi_B = dphi_A - pi), so eq. 23 gives
+  // D_Phi = 2 nu q tan(eps), not the zero of eq. 29
+  sim::ResonatorParams iso;
+  iso.dmu = 0.0;
+  iso.split_hz = 0.0;
+  p = truth_of(iso);
+  const double delta = 0.1, eps = -2 * delta, th = 0.3;
+  sim::AveragedModel m(iso);
+  sim::EnvelopeDrive dr;
+  dr.excitation = true;
+  dr.pump_v = sim::ElectrodeParams{}.threshold_v(iso.omega_rad_s(), iso.nu_per_s()) /
+              std::sqrt(std::cos(2 * delta));
+  dr.pump_phase_rad = M_PI / 4 + delta;
+  m.set_drive(dr);
+  m.set_max_step_s(1e-3);
+  m.set_standing_wave(1.0, th, 0.05, 0.0);
+  ControlDriftEstimator est;
+  est.set_model(p);
+  std::mt19937_64 rng(4);
+  for (int i = 0; i < 3000; ++i) {
+    m.advance(1e-3);
+    const WaveSample s = measure(m, kQuadratureNoiseV, rng);
+    est.add_sample({s.t_s, s.a_A_v, s.a_B_v, s.theta_A_rad, eps, 0, 0, dr.pump_v});
+  }
+  const sim::WaveState w = m.wave();
+  const double q = w.a_b_v / w.a_a_v;
+  sim::AveragedModel probe = m;
+  const double truth = measured_d_phi(probe, w.theta_rad, q);
+  std::printf(
+      "\nDe-pumped quadrature drift: model %.4e, estimate %.4e, 2 nu q tan(eps) %.4e rad/s\n",
+      truth, est.d_phi_rad_s(), 2 * iso.nu_per_s() * q * std::tan(eps));
+  CHECK(std::abs(truth) > 1e-5);
+  DOUBLES_EQUAL(truth, est.d_phi_rad_s(), 0.03 * std::abs(truth));
+}

@@ -10,7 +10,9 @@
 //   each 1 kHz tick:        step_output(theta_A, a_B/a_A, dt, excitation_on)
 //                           -> angle correction (input-axis rad) to add to
 //                              -2 (theta_A - theta_A0) / K
-//   with excitation on:     add_control_sample(...) feeds the D_Phi estimate
+//   with excitation on:     add_control_sample(...) feeds the D_Phi estimates
+//                           (pump phase error eps = pi/2 - 2 (phi_V - phi_A), pump
+//                           amplitude V0, quadrature forcer parts)
 //   window scheduler:       conditioning(), coverage_s(), least_covered_theta_rad()
 //
 // Units: seconds, radians, amplitudes in any consistent unit (volts), rates
@@ -31,13 +33,23 @@ class Estimator {
     WindowAccumulator::Config window{};
     NormalEquations::Config ls{};
     ControlDriftEstimator::Config control{};
+    PumpDriftEstimator::Config pump{};
     bool compensate_control_drift = true;
   };
 
   explicit Estimator(const Config& c)
-      : config_(c), window_(c.window), ls_(c.ls), comp_(c.angular_gain), control_(c.control) {}
+      : config_(c),
+        window_(c.window),
+        ls_(c.ls),
+        comp_(c.angular_gain),
+        control_(c.control),
+        pump_(c.pump) {}
 
-  Status begin_window(double t_switch_s) { return window_.begin_window(t_switch_s); }
+  Status begin_window(double t_switch_s) {
+    // The excitation-on segment of the pump fit ends here.
+    pump_.restart();
+    return window_.begin_window(t_switch_s);
+  }
   Status add_sample(const WaveSample& s) { return window_.add_sample(s); }
   // Folds the window into the normal equations; Status::too_short etc. drop it.
   Status end_window();
@@ -57,7 +69,12 @@ class Estimator {
   const ParamVector& model() const { return comp_.model(); }
   const Solution& last_solution() const { return last_; }
   double correction_rad() const { return comp_.correction_rad(); }
-  double d_phi_rad_s() const { return control_.valid() ? control_.d_phi_rad_s() : 0.0; }
+  // D_Phi at pattern angle theta (eq. 23 part + ring-pump gap part), rad/s.
+  double d_phi_rad_s(double theta_A_rad) const {
+    return (control_.valid() ? control_.d_phi_rad_s() : 0.0) +
+           (pump_.valid() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
+  }
+  const PumpDriftEstimator& pump_drift() const { return pump_; }
   Conditioning conditioning() const { return ls_.conditioning(); }
   const CoverageHistogram& coverage_s() const { return ls_.coverage_s(); }
   // Pattern angle (centre of the least covered 4theta bin, in [0, pi/2)).
@@ -72,6 +89,7 @@ class Estimator {
   NormalEquations ls_;
   DriftCompensator comp_;
   ControlDriftEstimator control_;
+  PumpDriftEstimator pump_;
   WindowContribution scratch_{};
   Solution last_{};
 };
