@@ -168,15 +168,20 @@ TEST(ClosedLoop, LoopsRecoverWithinOneSecondAfterATwoSecondFreeDecayWindow) {
 }
 
 TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
-  for (double a_set : {0.05, 1.0}) {
+  for (int run = 0; run < 4; ++run) {
+    const double a_set = run < 3 ? 0.05 : 1.0;
+    const double offset_hz = std::array<double, 4>{0.0, 2.0, -8.0, 0.0}[run];
     // GIVEN the resonator at rest. The 5 V forcer drive raises a_A by
     // g u / 2w = 0.0159 V/s and the pump at its 10 V limit adds the growth
     // rate k 10^2 / 8w - nu = 0.0318 1/s once there is a wave:
     // a(t) = (0.0159 / 0.0318)(e^{0.0318 t} - 1) reaches 0.9 a_set at
     // t = ln(1 + 0.9 a_set / 0.5) / 0.0318 (2.7 s for 0.05 V, 32 s for 1 V).
+    // The NCO may start off the resonance: the drive follows the measured wave
+    // phase as soon as there is a wave, which pulls it onto the resonance.
     ChainConfig cfg = rig_config();
     cfg.amplitude_setpoint_v = a_set;
     cfg.ring_up_theta_rad = 10.0 * kDeg;
+    cfg.f_center_hz = 5000.0 + offset_hz;
     ChainRig<q31_t> rig(cfg);
     rig.chain().set_excitation(true);
     // WHEN the chain runs
@@ -187,8 +192,10 @@ TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
     // THEN the handover to the pump comes when predicted and the pump holds
     // the wave at the set point along the commanded angle
     const double predicted_s = std::log(1.0 + 0.9 * a_set / 0.5) / 0.0318;
-    std::printf("\n  ring-up from rest to 0.9 x %.2f V: %.2f s (predicted %.2f s); a_A %.6f V\n",
-                a_set, handover_s, predicted_s, rig.out().wave.a_A);
+    std::printf(
+        "\n  ring-up from rest, NCO %+.0f Hz off, to 0.9 x %.2f V: %.2f s (predicted %.2f s); "
+        "a_A %.6f V\n",
+        offset_hz, a_set, handover_s, predicted_s, rig.out().wave.a_A);
     DOUBLES_EQUAL(predicted_s, handover_s, 0.05 * predicted_s);
     DOUBLES_EQUAL(a_set, rig.out().wave.a_A, a_set * 1e-4);
     // (once rung up the pattern is free: the damping drift nu dmu sin4theta / 2

@@ -73,7 +73,13 @@ struct ChainConfig {
   double quad_damping = 1.0;
   double pattern_gain_per_s = 5.0;  // angle command loop: theta' = k (target - theta)
   // Ring-up and validity.
-  double min_amplitude_v = 0.005;  // below this the phase is not measured
+  // Below this a_A the phase is not measured (PLL holds, drive phase frozen).
+  // Keep it low but above the demodulated noise floor: during ring-up from
+  // rest the drive only follows the resonance (self-excitation through the
+  // measured wave phase) once the wave is above it; until then it drives at
+  // the NCO frequency, whose off-resonance response stays near
+  // g u / (2 w dw) = 2.5e-4 V at 10 Hz off.
+  double min_amplitude_v = 1e-4;
   double ring_up_enter = 0.1;      // ring-up when a_A < enter * set point
   double ring_up_exit = 0.9;       // pump-only once a_A > exit * set point
   double ring_up_theta_rad = 0.0;  // pattern angle to ring up at from rest
