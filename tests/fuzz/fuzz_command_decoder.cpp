@@ -31,6 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   view.fault_input = (data[1] & 1) != 0;
   view.ident_active = (data[1] & 2) != 0;
   view.faults = (data[1] & 4) != 0 ? 1 : 0;
+  view.accepts_settings = (data[1] & 8) == 0;
   view.agc_setpoint_v = 0.05 + (data[2] | (data[3] << 8)) * 3e-5;
   data += 4;
   size -= 4;

@@ -183,6 +183,17 @@ TEST(CommandValidator, CommandsNotAllowedInTheCurrentModeAreRefused) {
          static_cast<uint8_t>(Mode::free_decay));
 }
 
+TEST(CommandValidator, SettingsAreRefusedByAFirmwareThatCannotChangeThemAtRunTime) {
+  ControllerView fixed = operating();
+  fixed.accepts_settings = false;
+  const uint8_t mode = static_cast<uint8_t>(Mode::operate);
+  expect(encode_ident(true, 1), fixed, CommandResult::wrong_state, mode);
+  expect(encode_window(60, 2, 1), fixed, CommandResult::wrong_state, mode);
+  expect(encode_agc(1.1, 1), fixed, CommandResult::wrong_state, mode);
+  expect(encode_set_mode(Mode::safe, 1), fixed, CommandResult::accepted);
+  expect(encode_status_request(2), fixed, CommandResult::accepted);
+}
+
 TEST(CommandValidator, UnsafeCommandsAreRefusedWithTheirReason) {
   ControllerView faulted = in_mode(Mode::safe);
   faulted.faults = hrg::fw::fault_bit(hrg::fw::Fault::dac_fault);

@@ -122,6 +122,10 @@ CommandOutcome CommandValidator::process(const hal::CanFrame& frame, const Contr
   Command c;
   c.id = static_cast<Cmd>(index);
   c.counter = counter;
+  const bool is_setting = c.id == Cmd::ident || c.id == Cmd::window || c.id == Cmd::agc;
+  if (is_setting && !st.accepts_settings) {
+    return refuse(CommandResult::wrong_state, counter, mode_detail);
+  }
   switch (c.id) {
     case Cmd::set_mode: {
       c.mode = static_cast<Mode>(decode_raw(m.signals[sig::target_mode], frame));

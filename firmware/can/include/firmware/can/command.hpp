@@ -49,6 +49,10 @@ struct ControllerView {
   bool fault_input = false;
   bool ident_active = false;
   double agc_setpoint_v = 0;
+  // False when this firmware build cannot change the window schedule, the AGC
+  // set point or identification at run time: those commands are then refused
+  // as wrong_state instead of being acknowledged and ignored.
+  bool accepts_settings = true;
 };
 
 struct CommandOutcome {
