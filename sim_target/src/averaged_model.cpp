@@ -180,8 +180,20 @@ AveragedModel::Mat5 AveragedModel::system_matrix(double t_s, const Vec5& r) cons
   lin += (half_inv * (0.5 * c.kappa * energy)) * C2::Identity();
   lin -= (half_inv * (0.5 * c.spring_k * std::norm(vc))) * gap;
   const double nu = c.nu_per_s;
-  lin(0, 0) += kI * (w - w_ref) - nu * (1.0 + c.dmu * c.c4mu);
-  lin(1, 1) += kI * (w - w_ref) - nu * (1.0 - c.dmu * c.c4mu);
+  // A frequency that drifts with temperature changes the amplitude adiabatically
+  // (a^2 w is invariant): a'/a = -w'/(2w). The full-rate model has it by itself.
+  double adiabatic = 0.0;
+  if (effects_.thermal_frequency.enabled) {
+    const double dw_dt =
+        params_.omega_rad_s() * 1e-6 * effects_.thermal_frequency.ppm_per_c * temp_.derivative(t_s);
+    adiabatic = -dw_dt / (2.0 * w);
+  }
+  // Both circular modes ring at sqrt(w^2 + (Omega K)^2) -+ Omega K: a common
+  // second-order shift (Omega K)^2 / 2w that moves the phase, not the pattern.
+  const double coriolis_shift = std::pow(rate * params_.angular_gain, 2) / (2.0 * w);
+  const cplx detune = kI * (w - w_ref + coriolis_shift);
+  lin(0, 0) += detune - nu * (1.0 + c.dmu * c.c4mu) + adiabatic;
+  lin(1, 1) += detune - nu * (1.0 - c.dmu * c.c4mu) + adiabatic;
   lin(0, 1) += -nu * c.dmu * c.s4mu + rate * params_.angular_gain;
   lin(1, 0) += -nu * c.dmu * c.s4mu - rate * params_.angular_gain;
 

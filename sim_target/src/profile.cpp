@@ -94,6 +94,26 @@ Profile Profile::table_file(const std::string& path, double scale) {
   return ramps(std::move(points));
 }
 
+double Profile::derivative(double t_s) const {
+  switch (kind_) {
+    case Kind::constant:
+    case Kind::steps: return 0.0;
+    case Kind::sine: {
+      const double w = 2.0 * std::numbers::pi * freq_hz_;
+      return amplitude_ * w * std::cos(w * t_s + phase_rad_);
+    }
+    case Kind::ramps: {
+      if (t_s < points_.front().t_s || t_s >= points_.back().t_s) return 0.0;
+      auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
+                                 [](double t, const ProfilePoint& p) { return t < p.t_s; });
+      const ProfilePoint& b = *it;
+      const ProfilePoint& a = *std::prev(it);
+      return (b.value - a.value) / (b.t_s - a.t_s);
+    }
+  }
+  return 0.0;
+}
+
 double Profile::integral(double t0_s, double t1_s) const {
   if (kind_ == Kind::constant) return offset_ * (t1_s - t0_s);
   if (kind_ == Kind::sine) {

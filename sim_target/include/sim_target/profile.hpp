@@ -41,6 +41,9 @@ class Profile {
   }
 
   double value(double t_s) const;
+  // Time derivative (per second); 0 for constant and steps, the segment's
+  // slope for ramps (the later segment at a corner).
+  double derivative(double t_s) const;
   // Exact integral of the profile over [t0_s, t1_s] (e.g. the input angle).
   double integral(double t0_s, double t1_s) const;
   // The first time after t_s where the profile has a corner (steps: a jump;
