@@ -24,12 +24,14 @@
 // means), which cuts the cost of the rank-one updates by that factor and loses
 // a fraction (block/window)^2 of the information.
 //
-// Transient rule. When the drive switches off, the demodulator's output still
-// holds the drive's effect for the length of its low-pass impulse response,
-// and the loops' last commands are still decaying in the resonator's
-// electrodes. Samples with t_s < t_begin + settle_s are ignored; settle_s must
-// be at least the demodulator's filter length plus one control period (the
-// default 20 ms covers a 100 kHz FIR of up to 1800 taps and its latency).
+// Transient rule. An output of the demodulator depends on the pickoff samples
+// of its low-pass span: the sinc^3 decimator of dsp/demodulator.hpp has 3L - 2
+// taps, 2.98 ms for L = 100 at 100 kHz, i.e. the first 3 control-rate outputs
+// after the switch still hold samples taken with the drive on; the DAC adds up
+// to one block of latency before the drive is really off. Samples with
+// t_s < t_switch_s + settle_s are therefore ignored, with
+//   settle_s >= (3L - 2)/f_adc + DAC latency + one control period  (~5 ms).
+// The default 20 ms is four times that, and costs 0.4 % of a 5 s window.
 //
 // Context: task level at the control rate; no heap, no exceptions.
 
