@@ -98,7 +98,7 @@ int main() {
     }
     const double per_s = blocks * 100.0 / cpu_since(t0);
     std::printf(
-        "simulated board (ADC noise + DAC + resonator):       %6.1f M frames/s (%5.0fx real "
+        "simulated board (ADC noise + DAC + resonator):       %6.1f M frames/CPU-s (%5.0fx real "
         "time)\n",
         per_s / 1e6, per_s / 1e5);
   }
