@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "dsp/chain.hpp"
@@ -43,6 +44,11 @@ class ChainRig {
   }
 
   sim::Resonator& resonator() { return res_; }
+  // White Gaussian pickoff noise (V rms per sample, both channels), seeded.
+  void set_pickoff_noise(double rms_v, uint64_t seed) {
+    noise_rms_v_ = rms_v;
+    rng_.seed(seed);
+  }
   Chain<T>& chain() { return chain_; }
   const ChainOutputs& out() const { return chain_.outputs(); }
   // The ADC block of the last block() (for chains observing the same data).
@@ -54,8 +60,10 @@ class ChainRig {
     const double dt = 1.0 / cfg_.sample_rate_hz;
     for (uint32_t j = 0; j < l_; ++j) {
       const sim::PickoffOutput p = res_.measured();
-      adc_[2 * j] = q31_from_f64_sat(p.x_v / kAdcFullScaleV);
-      adc_[2 * j + 1] = q31_from_f64_sat(p.y_v / kAdcFullScaleV);
+      const double nx = noise_rms_v_ > 0.0 ? noise_rms_v_ * gauss_(rng_) : 0.0;
+      const double ny = noise_rms_v_ > 0.0 ? noise_rms_v_ * gauss_(rng_) : 0.0;
+      adc_[2 * j] = q31_from_f64_sat((p.x_v + nx) / kAdcFullScaleV);
+      adc_[2 * j + 1] = q31_from_f64_sat((p.y_v + ny) / kAdcFullScaleV);
       sim::Drive d;
       d.pump_v = f64_from_q31(dac_now_[3 * j]) * kDacFullScaleV;
       d.forcer_x_v = f64_from_q31(dac_now_[3 * j + 1]) * kDacFullScaleV;
@@ -87,6 +95,9 @@ class ChainRig {
   std::vector<q31_t> adc_;
   std::vector<q31_t> dac_now_;
   std::vector<q31_t> dac_next_;
+  double noise_rms_v_ = 0.0;
+  std::mt19937_64 rng_{1};
+  std::normal_distribution<double> gauss_{0.0, 1.0};
 };
 
 }  // namespace hrg::dsp::test
