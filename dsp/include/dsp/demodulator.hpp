@@ -10,7 +10,8 @@
 //
 // Low-pass: the cascade of three boxcars, each one block (L samples) long
 // (a sinc^3 / third-order CIC response, 3L - 2 taps, delay 1.5 L - 1 samples),
-// decimated by L. Periodicity rule (seed): the default block of 100 samples
+// decimated by L. Periodicity rule (seed, section 3: average "with control of
+// periodicity for w: <cos wt sin wt> = 0"): the default block of 100 samples
 // at 100 kHz spans exactly 5 periods of the 5 kHz resonance, so the 2f image
 // of the mixing products falls on a zero of every boxcar. The resonance is
 // not exactly at a multiple of fs / 2L and the PLL moves it; the third order
