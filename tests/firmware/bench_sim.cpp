@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// Benchmark (prints figures): firmware + sim_target in lockstep, simulated
+// seconds per wall and per CPU second at fs = 100 kHz on one core; then the
+// same executive paced in real time, per-task worst-case time.
+#include <cstdio>
+
+#include "sim_tools/job.hpp"
+
+#include "support/cpputest.hpp"
+
+namespace {
+void print_tasks(const hrg::simtools::JobResult& r) {
+  for (const auto& t : r.tasks) {
+    std::printf("  %-10s %5u Hz budget %6.1f us  max %8.1f us  mean %7.2f us  overruns %u\n",
+                t.name.c_str(), t.rate_hz, t.budget_ns / 1e3, t.max_ns / 1e3, t.mean_ns / 1e3,
+                t.overruns);
+  }
+  std::printf("  frames %llu, missed %u, deadline misses %u, max frame %.1f us\n",
+              static_cast<unsigned long long>(r.frames.frames), r.frames.missed_frames,
+              r.frames.deadline_misses, r.frames.max_frame_ns / 1e3);
+}
+
+void run_benchmark() {
+  auto job = hrg::simtools::default_job(60.0, 16);
+  hrg::simtools::RunOptions opt;
+  const auto r = hrg::simtools::run_job(job, opt);
+  std::printf("\nlockstep, fs %u Hz, %.0f simulated s:\n", job.sim.adc.sample_rate_hz, r.sim_s);
+  std::printf("  realtime factor %.1f x wall (%.2f s), %.1f x CPU (%.2f s); goal >= 50\n",
+              r.realtime_factor, r.wall_s, r.realtime_factor_cpu, r.cpu_s);
+  std::printf("  share in the simulated target (resonator + converters): %.0f %%\n",
+              100.0 * r.sim_share);
+  print_tasks(r);
+
+  auto rt_job = hrg::simtools::default_job(5.0, 16);
+  opt.real_time = true;
+  const auto rt = hrg::simtools::run_job(rt_job, opt);
+  std::printf("real time (CLOCK_MONOTONIC, 1 ms frames, %s), %.0f s:\n", rt.realtime_setup.c_str(),
+              rt.sim_s);
+  print_tasks(rt);
+}
+}  // namespace
+
+TEST_GROUP(BenchSim){};
+
+TEST(BenchSim, LockstepSpeedAndRealTimeTaskTimes) {
+  // The simulated target is a process-wide instance that keeps its buffers:
+  // the leak checker is off while it runs.
+  MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+  run_benchmark();
+  MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
+}

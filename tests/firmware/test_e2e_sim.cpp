@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: MIT
+// End to end: firmware + sim_target in lockstep on a shortened default
+// scenario (ring-up from rest, rate-table sweep, 8 parked angles).
+#include <cmath>
+#include <numbers>
+
+#include "sim_tools/job.hpp"
+#include "sim_tools/report.hpp"
+
+#include "support/cpputest.hpp"
+
+using hrg::simtools::JobConfig;
+using hrg::simtools::JobResult;
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
+
+// One run shared by the tests of the group (it takes a few seconds).
+const JobConfig& job() {
+  static const JobConfig j = hrg::simtools::default_job(0.0, 8);
+  return j;
+}
+const JobResult& result() {
+  static const JobResult r = [] {
+    JobResult x = hrg::simtools::run_job(job(), {});
+    hrg::simtools::judge(job(), x);
+    return x;
+  }();
+  return r;
+}
+}  // namespace
+
+TEST_GROUP(EndToEnd){
+    void setup() override{// The shared run is made once and kept for the whole group: it is not a
+                          // leak of the first test that happens to trigger it.
+                          MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+(void)result();
+MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
+}
+}
+;
+
+TEST(EndToEnd, TheGyroRingsUpFromRestAndLocksWithinTheForcerRingUpTime) {
+  // GIVEN a resonator at rest (1 mV) and forcers of gain g = 200 1/s^2 at up
+  // to 5 V: a_A' = g u / (2 w) = 0.0159 V/s, so the forcers alone reach
+  // 0.95 V in 60 s; the pump takes over above 0.9 V and the loops settle in 0.2 s.
+  const double w = 2 * kPi * job().chain.f_center_hz;
+  const double rate_v_s = job().chain.forcer_gain_per_s2 * job().chain.forcer_max_v / (2 * w);
+  const double bound_s = 0.95 * job().gyro.amplitude_set_v / rate_v_s + 1.0;
+  CHECK(result().reached_operate);
+  CHECK(result().t_operate_s > 1.0);
+  CHECK(result().t_operate_s < bound_s);
+  CHECK(hrg::fw::Mode::operate == result().final_mode ||
+        hrg::fw::Mode::free_decay == result().final_mode ||
+        hrg::fw::Mode::recover == result().final_mode);
+}
+
+TEST(EndToEnd, TheRawOutputFollowsTheTrueAngleWithinWhatTheDriftModelPredicts) {
+  // THEN at every row with a valid output, raw - true = -integral(D/K) of the
+  // true drift (physics.md section 3) within 5 % of the integral of |D|/K
+  // plus 0.02 deg (demodulator lag while turning, noise, control-loop drift).
+  const auto& r = result();
+  const double dt_h = 1.0 / job().telemetry_hz / 3600.0;
+  double model = 0, bound = 0, worst = 0;
+  bool saw_turn = false;
+  for (const auto& row : r.rows) {
+    if (!row.out_valid) continue;
+    model -= row.drift_true_dph * dt_h;
+    bound += std::fabs(row.drift_true_dph) * dt_h;
+    saw_turn = saw_turn || std::fabs(row.rate_dps) > 5.0;
+    const double e = row.raw_angle_deg - row.true_angle_deg;
+    worst = std::fmax(worst, std::fabs(e - model) - 0.05 * bound);
+  }
+  CHECK(saw_turn);
+  CHECK(bound > 0.2);  // the drift is large enough to be seen
+  CHECK(worst < 0.02);
+}
+
+TEST(EndToEnd, TheOutputTracksTheRateTableSweep) {
+  // The sweep turns the case by 2 * 90 deg * 2 / K (two 4 theta turns of the
+  // pattern); the output must report that turn to within the drift bound.
+  const auto& r = result();
+  const double k = job().sim.resonator.angular_gain;
+  const double turn_deg = 2.0 * 90.0 * 2.0 / k;
+  double out0 = 0, true0 = 0, out1 = 0, true1 = 0, t0 = 0, t1 = 0;
+  bool have0 = false;
+  for (const auto& row : r.rows) {
+    if (!row.out_valid) continue;
+    if (!have0 && row.t_s >= 44.0) {
+      out0 = row.out_angle_deg;
+      true0 = row.true_angle_deg;
+      t0 = row.t_s;
+      have0 = true;
+    }
+    if (row.t_s <= job().sweep_end_s) {
+      out1 = row.out_angle_deg;
+      true1 = row.true_angle_deg;
+      t1 = row.t_s;
+    }
+  }
+  CHECK(have0);
+  const double earth_deg = job().earth_rate_rad_s * (t1 - t0) * 180.0 / kPi;
+  DOUBLES_EQUAL(turn_deg + earth_deg, true1 - true0, 0.01);
+  DOUBLES_EQUAL(true1 - true0, out1 - out0, 0.3);
+}
+
+TEST(EndToEnd, RunsFreeDecayWindowsUntilEveryBinHasItsMinimum) {
+  const auto& r = result();
+  const auto& wc = job().gyro.windows;
+  CHECK(r.campaign_done);
+  CHECK(r.windows >= wc.bins * wc.min_windows_per_bin);
+  LONGS_EQUAL(r.windows, r.windows_accepted);
+  // Duty: each window is length_frames of excitation off.
+  const double expected = r.windows * wc.length_frames / (job().duration_s * 1000.0);
+  DOUBLES_EQUAL(expected, r.excitation_off_fraction, 0.002);
+}
+
+TEST(EndToEnd, IdentifiesDampingAnisotropyAndSplitWithinTheirUncertainty) {
+  const auto& r = result();
+  CHECK(r.identification.valid);
+  for (int i = 0; i < 5; ++i) {
+    const double sigma = r.identification.sigma[i];
+    CHECK(sigma > 0);
+    CHECK(sigma < 0.05 * job().sim.resonator.nu_per_s() * job().sim.resonator.dmu);
+    CHECK(std::fabs(r.identification.p[i] - r.truth[static_cast<std::size_t>(i)]) < 5 * sigma);
+  }
+}
+
+TEST(EndToEnd, CompensationRemovesTheAngleDependentBias) {
+  // Raw: D_nu / K = nu dmu sin 4(theta - th_mu) / K (quadrature nulled), an
+  // ADB of nu dmu / K = 58.5 deg/h for the seed's resonator.
+  const auto& r = result();
+  const auto& p = job().sim.resonator;
+  const double adb_dph = p.nu_per_s() * p.dmu / p.angular_gain * kRadSToDph;
+  LONGS_EQUAL(8, r.parks.size());
+  CHECK(r.fit_raw.ok);
+  DOUBLES_EQUAL(adb_dph, r.fit_raw.amplitude(), 0.03 * adb_dph);
+  CHECK(r.fit_comp.amplitude() < 2.0);  // the cited requirement is <= 3 deg/h
+  CHECK(std::fabs(r.fit_comp.b0) < 1.0);
+}
+
+TEST(EndToEnd, TheExecutiveRanEveryFrameWithoutMisses) {
+  const auto& r = result();
+  LONGS_EQUAL(std::llround(job().duration_s * 1000.0), r.frames.frames);
+  LONGS_EQUAL(0, r.frames.missed_frames);
+  LONGS_EQUAL(0, r.frames.deadline_misses);
+  CHECK(r.can_frames > 0);
+  CHECK(r.failures.empty());
+}
