@@ -31,10 +31,10 @@ const JobResult& result() {
 }
 }  // namespace
 
-TEST_GROUP(EndToEnd){
-    void setup() override{// The shared run is made once and kept for the whole group: it is not a
-                          // leak of the first test that happens to trigger it.
-                          MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+TEST_GROUP(EndToEnd){void setup()
+                         override{// The shared run is made once and kept for the whole group: it is
+                                  // not a leak of the first test that happens to trigger it.
+                                  MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
 (void)result();
 MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
 }
