@@ -24,8 +24,7 @@ constexpr double kDeg = kPi / 180.0;
 WaveVariables<double> true_wave(hrg::sim::Resonator& r) {
   std::complex<double> x, y;
   r.envelopes(x, y);
-  // X = cx - i sx
-  return wave_variables(Quadratures<double>{x.real(), -x.imag(), y.real(), -y.imag()});
+  return wave_variables(quadratures_of_envelopes(x, y));
 }
 }  // namespace
 

@@ -2,6 +2,7 @@
 #include "dsp/wave_variables.hpp"
 
 #include <cmath>
+#include <complex>
 #include <numbers>
 
 #include "support/cpputest.hpp"
@@ -66,6 +67,17 @@ TEST(WaveVariables, InverseMatchesTheSampledDefinition) {
   DOUBLES_EQUAL(b.sx, a.sx, 1e-13);
   DOUBLES_EQUAL(b.cy, a.cy, 1e-13);
   DOUBLES_EQUAL(b.sy, a.sy, 1e-13);
+}
+
+TEST(WaveVariables, EnvelopesMapToQuadraturesAsPhysicsMdDefines) {
+  // x = Re(X e^{iwt}) with X = cx - i sx: x = cx cos wt + sx sin wt
+  const std::complex<double> x_env(0.3, -0.4), y_env(-0.1, 0.2);
+  const auto q = hrg::dsp::quadratures_of_envelopes(x_env, y_env);
+  for (double wt : {0.0, 0.7, 2.0, 4.4}) {
+    const std::complex<double> e(std::cos(wt), std::sin(wt));
+    DOUBLES_EQUAL((x_env * e).real(), q.cx * std::cos(wt) + q.sx * std::sin(wt), 1e-15);
+    DOUBLES_EQUAL((y_env * e).real(), q.cy * std::cos(wt) + q.sy * std::sin(wt), 1e-15);
+  }
 }
 
 TEST(WaveVariables, SmallQuadratureKeepsRelativePrecisionInFloat) {

@@ -29,6 +29,7 @@
 // no heap, no exceptions, callable from any context.
 
 #include <cmath>
+#include <complex>
 #include <cstdint>
 #include <numbers>
 #include <type_traits>
@@ -99,6 +100,14 @@ Quadratures<T> quadratures_of_wave(T a_A, T a_B, T theta_A_rad, T phase_rad) {
   q.cy = a_A * s2 * cp + a_B * c2 * sp;
   q.sy = -a_A * s2 * sp + a_B * c2 * cp;
   return q;
+}
+
+// Quadratures of complex envelopes x = Re(X e^{iwt}), y = Re(Y e^{iwt})
+// (physics.md: X = cx - i sx, Y = cy - i sy), e.g. the simulator's analytic
+// envelopes.
+template <typename T>
+Quadratures<T> quadratures_of_envelopes(std::complex<T> x_env, std::complex<T> y_env) {
+  return Quadratures<T>{x_env.real(), -x_env.imag(), y_env.real(), -y_env.imag()};
 }
 
 // Keeps theta_A continuous through any number of turns. The wrapped angle has
