@@ -124,6 +124,46 @@ TEST(ClosedLoop, AgcHoldsTheAmplitudeAndQuadratureIsNulledInSteadyState) {
   CHECK(worst_true_q < 1e-4);
 }
 
+TEST(ClosedLoop, PumpPhaseOfPiOverFourAddsEnergyToWaveA) {
+  // The resonant part of the pump force is k V0^2 a / 4 cos(psi + 2 dphi_V
+  // - pi/2 + ...): with phi_V = pi/4 + d it pumps at cos(2d) of its best, so
+  // the AGC needs V0(d) = V0(0) / sqrt(cos 2d); at d = pi/2 it removes energy.
+  auto settle = [](double phase_rad, double t_s, double& v0, double& a_a) {
+    ChainConfig cfg = rig_config();
+    cfg.pump_phase_rad = phase_rad;
+    ChainRig<q31_t> rig(cfg);
+    rig.resonator().set_standing_wave(1.0, 0.2);
+    rig.chain().set_excitation(true);
+    rig.run(t_s);
+    v0 = rig.out().pump_v;
+    a_a = rig.out().wave.a_A;
+  };
+  double v0_best = 0, a = 0;
+  settle(kPi / 4, 4.0, v0_best, a);
+  for (double d : {0.3, -0.3}) {
+    double v0 = 0;
+    settle(kPi / 4 + d, 4.0, v0, a);
+    std::printf("\n  pump phase pi/4 %+.1f rad: V0 %.5f V, V0(0)/sqrt(cos 2d) = %.5f V\n", d, v0,
+                v0_best / std::sqrt(std::cos(2 * d)));
+    DOUBLES_EQUAL(v0_best / std::sqrt(std::cos(2 * d)), v0, 2e-3 * v0);
+    DOUBLES_EQUAL(1.0, a, 1e-4);
+  }
+  // At pi/4 + pi/2 the pump damps: the AGC drives it to its limit within a
+  // few tens of ms and a_A decays at up to nu_A + k V0max^2 / 8w (times the
+  // hold's sin(x)/x at 2f) = 0.0032 + 0.0343 1/s instead of nu_A.
+  double v0 = 0;
+  settle(3 * kPi / 4, 1.0, v0, a);
+  const hrg::sim::ResonatorParams rp;
+  const double x = 2.0 * kPi * 5000.0 / 100000.0;
+  const double nu_a = rp.nu_per_s() * (1 + rp.dmu * std::cos(0.8));
+  const double g_max = 87.73 * 100.0 / (8.0 * rp.omega_rad_s()) * std::sin(x) / x;
+  std::printf("  pump phase 3 pi/4: a_A after 1 s %.5f V (free decay %.5f, full anti-pump %.5f)\n",
+              a, std::exp(-nu_a), std::exp(-(nu_a + g_max)));
+  DOUBLES_EQUAL(10.0, v0, 1e-9);
+  CHECK(a >= std::exp(-(nu_a + g_max)));
+  CHECK(a <= std::exp(-(nu_a + 0.8 * g_max)));
+}
+
 TEST(ClosedLoop, LoopsHoldWithPickoffNoise) {
   // GIVEN white pickoff noise of 0.3 mV rms per sample (70 dB below the wave)
   ChainRig<q31_t> rig(rig_config());
