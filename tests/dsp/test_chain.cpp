@@ -66,6 +66,15 @@ TEST(ChainConfig, AnUnusableConfigurationMakesProcessRefuse) {
 
 TEST_GROUP(Chain){};
 
+TEST(Chain, RefusesAnAmplitudeSetPointOutsideTheAdcRange) {
+  Chain<q31_t> chain(ChainConfig{});
+  CHECK(chain.set_amplitude_setpoint_v(0.5));
+  CHECK_FALSE(chain.set_amplitude_setpoint_v(0.0));
+  CHECK_FALSE(chain.set_amplitude_setpoint_v(-1.0));
+  CHECK_FALSE(chain.set_amplitude_setpoint_v(2.0));  // the default ADC full scale
+  CHECK_FALSE(chain.set_amplitude_setpoint_v(std::nan("")));
+}
+
 TEST(Chain, RefusesBlocksOfTheWrongSize) {
   Chain<q31_t> chain(ChainConfig{});
   std::vector<q31_t> adc(200, 0), dac(300, 0), short_adc(198, 0), short_dac(297, 0);

@@ -139,7 +139,13 @@ class Chain {
   // theta_target_rad (unwrapped) at up to max_rate_rad_s; without it no
   // rotating force is applied (whole-angle mode).
   void set_pattern_command(bool enabled, double theta_target_rad, double max_rate_rad_s);
-  void set_amplitude_setpoint_v(double a_set_v) { agc_.set_setpoint_v(a_set_v); }
+  // AGC set point for a_A, volts of pickoff; must lie in (0, adc_full_scale_v),
+  // else it is refused (false) and the previous set point stays.
+  bool set_amplitude_setpoint_v(double a_set_v) {
+    if (!(a_set_v > 0.0 && a_set_v < cfg_.adc_full_scale_v)) return false;
+    agc_.set_setpoint_v(a_set_v);
+    return true;
+  }
 
   // One block: adc = block_frames * 2 words, dac = block_frames * 3 words.
   // Returns false (and touches nothing) on a size mismatch or an unusable
