@@ -9,6 +9,7 @@
 //   can_rig check LOG           check a candump -L log of a scripted run
 //   can_rig write-log FILE      a log for canplayer (CandumpLogWriter)
 //   can_rig check-replay LOG    the replayed frames equal what write-log wrote
+//   can_rig check-firmware LOG  check a capture of hrg-board (the firmware)
 // Environment for run: HRG_GPIO_CHIP, HRG_GPIO_SYSFS (as test_hal_linux_kernel).
 #include <signal.h>
 
@@ -205,12 +206,13 @@ int main(int argc, char** argv) {
     if (cmd == "check" && argc == 3) return rig::check_log(argv[2]);
     if (cmd == "write-log" && argc == 3) return rig::write_replay_log(argv[2]);
     if (cmd == "check-replay" && argc == 3) return rig::check_replay(argv[2]);
+    if (cmd == "check-firmware" && argc == 3) return rig::check_firmware_log(argv[2]);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "can_rig: %s\n", e.what());
     return 1;
   }
   std::fprintf(stderr,
                "usage: can_rig frames | run IFACE SECONDS | check LOG | write-log FILE | "
-               "check-replay LOG\n");
+               "check-replay LOG | check-firmware LOG\n");
   return 2;
 }

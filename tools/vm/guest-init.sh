@@ -57,7 +57,7 @@ check test_hal_linux_kernel test_hal_linux_kernel -v
 
 step "scripted board run on vcan0"
 cd /tmp
-candump -L vcan0 > /tmp/capture.log &
+candump -r 8000000 -L vcan0 > /tmp/capture.log &
 dump=$!
 can_rig run vcan0 60 > /tmp/rig.out 2>&1 &
 rig=$!
@@ -107,5 +107,28 @@ rig_rc=$?
 cat /tmp/rig1.out
 check "board run on a full queue" [ $rig_rc -eq 0 ]
 check "queue-full counted" grep -q "tx_queue_full [1-9]" /tmp/rig1.out
+
+if [ -x /usr/bin/hrg-board ]; then
+  step "the firmware on this target (hrg-board: simulated converters, vcan0, gpio-sim)"
+  candump -r 8000000 -L vcan0 > /tmp/firmware.log &
+  dump=$!
+  hrg-board --can vcan0 --gpio-chip hrg-sim --exc-line 0 --fault-line 1 --seconds 60 \
+    > /tmp/board.out 2>&1 &
+  board=$!
+  sleep 3
+  cansend vcan0 "$CMD_STATUS1"
+  sleep 0.2
+  cansend vcan0 "$CMD_WINDOW"
+  sleep 1
+  echo "guest: excitation enable line on gpio-sim reads $(cat "$HRG_GPIO_SYSFS/sim_gpio0/value")"
+  kill -TERM $board
+  wait $board
+  board_rc=$?
+  sleep 0.2
+  kill $dump
+  cat /tmp/board.out
+  check "hrg-board run" [ $board_rc -eq 0 ]
+  check "firmware capture" can_rig check-firmware /tmp/firmware.log
+fi
 
 if [ $failed -eq 0 ]; then report PASS; else report FAIL; fi
