@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Scenario files: the shipped default, units converted, bad input named.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -97,4 +99,29 @@ TEST(Scenario, SameSeedGivesTheSameBits) {
   hal::board().adc.read_block(b, t_ns, clipped);
   CHECK(a != b);
   target().configure(SimConfig{});
+}
+
+TEST(Scenario, TableProfilesAreReadRelativeToTheScenarioFile) {
+  const std::string dir = "test_scenario_dir";
+  std::filesystem::create_directories(dir);
+  std::FILE* f = std::fopen((dir + "/rate.csv").c_str(), "w");
+  std::fputs("t_s,rate_dps\n0,0\n2,180\n", f);
+  std::fclose(f);
+  f = std::fopen((dir + "/s.toml").c_str(), "w");
+  std::fputs("[rate]\nkind = \"table\"\nfile = \"rate.csv\"\n", f);
+  std::fclose(f);
+  const SimConfig c = load_scenario(dir + "/s.toml");
+  DOUBLES_EQUAL(kPi / 2, c.rate_rad_s.value(1.0), 1e-15);
+  f = std::fopen((dir + "/s.toml").c_str(), "w");
+  std::fputs("[rate]\nkind = \"table\"\nfile = \"missing.csv\"\n", f);
+  std::fclose(f);
+  std::string err;
+  try {
+    load_scenario(dir + "/s.toml");
+  } catch (const ScenarioError& e) {
+    err = e.what();
+  }
+  CHECK(contains(err, "key 'rate.file': "));
+  CHECK(contains(err, "missing.csv: cannot open profile table"));
+  std::filesystem::remove_all(dir);
 }
