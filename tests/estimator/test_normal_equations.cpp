@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "malloc_counter.hpp"
 #include "synthetic_decay.hpp"
 #include "window_runner.hpp"
 
@@ -238,16 +239,29 @@ TEST(NormalEquations, UpdateAndSolveAllocateNothing) {
       gen.step(st, 1e-3);
       samples.push_back(gen.measure(st, 2e-5, rng));
     }
+    malloc_counter_arm();
     Eigen::internal::set_is_malloc_allowed(false);
     est.begin_window(st.t_s - 0.5);
     for (const auto& s : samples)
       est.add_sample(s);
     const Status e = est.end_window();
     const Solution sol = est.solve_and_accept();
+    const Solution alt = est.normal_equations().solve(Variant::alternating);
+    est.add_control_sample({st.t_s, 1.0, 0.0, 0.1, 0.01, 0.0, 0.0, 3.0});
     est.step_output(st.theta_rad, 0.0, 1e-3, true);
+    (void)est.cramer_rao_bound(2e-5);
     Eigen::internal::set_is_malloc_allowed(true);
+    CHECK_EQUAL(0L, malloc_counter_disarm());
+    (void)alt;
     CHECK(e == Status::ok);
     if (k >= 4) CHECK(sol.accepted());
   }
   CHECK(est.has_model());
+  // The counter itself sees a dynamic allocation (so the check above can fail).
+  if (malloc_counter_available()) {
+    malloc_counter_arm();
+    Eigen::MatrixXd dynamic(7, 7);
+    dynamic.setZero();
+    CHECK(malloc_counter_disarm() > 0);
+  }
 }
