@@ -78,7 +78,7 @@ void Resonator::set_state(double x_v, double y_v, double vx_v_per_s, double vy_v
 
 void Resonator::set_envelopes(std::complex<double> x_env, std::complex<double> y_env) {
   const double w = omega_rad_s();
-  const std::complex<double> carrier = std::polar(1.0, w * t_s_);
+  const std::complex<double> carrier = std::polar(1.0, w * time_s());
   const std::complex<double> i_w{0.0, w};
   set_state((x_env * carrier).real(), (y_env * carrier).real(), (i_w * x_env * carrier).real(),
             (i_w * y_env * carrier).real());
@@ -163,7 +163,12 @@ double Resonator::pump_delayed(double delay_samples) const {
 }
 
 void Resonator::step(const Drive& drive, double dt_s) {
-  const double t_mid = t_s_ + 0.5 * dt_s;
+  if (dt_s != step_s_) {
+    t0_s_ = time_s();
+    steps_ = 0;
+    step_s_ = dt_s;
+  }
+  const double t_mid = time_s() + 0.5 * dt_s;
   const double rate = rate_.value(t_mid);
   const double temp_c = temp_.value(t_mid);
   const double w = detail::thermal_omega(params_, effects_, temp_c);
@@ -218,7 +223,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   if (c_damp != 0.0) next.noalias() += psi_damp_ * (c_damp * u_);
 
   u_ = next;
-  t_s_ += dt_s;
+  ++steps_;
 }
 
 PickoffOutput Resonator::measured() const {

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <complex>
+#include <cstdint>
 
 #include <Eigen/Dense>
 
@@ -66,7 +67,10 @@ class Resonator {
   // Reference frequency that defines the DC part of V^2 (one period average)
   // and the quarter-period used by the feedthrough phase; default f_hz.
   void set_reference_hz(double f_hz);
-  void set_time(double t_s) { t_s_ = t_s; }
+  void set_time(double t_s) {
+    t0_s_ = t_s;
+    steps_ = 0;
+  }
 
   // x = Re(X e^{i w t}), y = Re(Y e^{i w t}) with w the present mean frequency,
   // velocities to match: a free state that starts the given envelopes now.
@@ -78,13 +82,14 @@ class Resonator {
   // Advances by dt_s (normally 1/fs) with the drive held. Pure physics.
   void step(const Drive& u, double dt_s);
 
-  double time_s() const { return t_s_; }
+  // t0 + n dt: counted, not summed, so 6e7 steps of 1e-5 s end at 600 s exactly.
+  double time_s() const { return t0_s_ + static_cast<double>(steps_) * step_s_; }
   double x_v() const { return u_(0); }
   double y_v() const { return u_(1); }
   double vx_v_per_s() const { return u_(2); }
   double vy_v_per_s() const { return u_(3); }
-  double rate_rad_s() const { return rate_.value(t_s_); }
-  double temperature_c() const { return temp_.value(t_s_); }
+  double rate_rad_s() const { return rate_.value(time_s()); }
+  double temperature_c() const { return temp_.value(time_s()); }
   double omega_rad_s() const;  // mean angular frequency now (thermal effect included)
   // Analytic envelopes X = x - i x'/w, Y = y - i y'/w (x = Re X at this instant);
   // wave_state() of them gives E, Q, R, S and theta_A of the true wave.
@@ -106,7 +111,9 @@ class Resonator {
   Profile rate_;
   Profile temp_;
   double f_ref_hz_;
-  double t_s_ = 0.0;
+  double t0_s_ = 0.0;
+  uint64_t steps_ = 0;
+  double step_s_ = 0.0;
   Vec4 u_ = Vec4::Zero();
 
   // Expansion point and its propagators.
