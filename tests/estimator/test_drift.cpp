@@ -197,6 +197,17 @@ TEST(ControlDrift, EstimatorKeepsNoModelFromIllConditionedWindows) {
   }
   CHECK(est.solve_and_accept().status == Status::ill_conditioned);
   CHECK_FALSE(est.has_model());
+  // an aborted window adds nothing
+  const double windows = est.normal_equations().windows();
+  est.begin_window(1000.0);
+  DecayState s{1000.0, 1.0, 0.0, 0.7};
+  for (int i = 0; i < 500; ++i) {
+    gen.step(s, 1e-3);
+    est.add_sample(gen.measure(s, 2e-5, rng));
+  }
+  est.abort_window();
+  CHECK(est.end_window() == Status::not_in_window);
+  DOUBLES_EQUAL(windows, est.normal_equations().windows(), 0.0);
   DOUBLES_EQUAL(0.0, est.drift_rate_rad_s(0.3, 0.0), 0.0);
   CHECK(est.conditioning().kappa_2 > cfg.ls.max_kappa_2);
   // the scheduler is pointed away from the one covered bin

@@ -6,6 +6,7 @@
 //   free_decay entered:     begin_window(t_switch_s)
 //   each 1 kHz tick in it:  add_sample({t_s, a_A, a_B, theta_A, E})
 //   free_decay left:        end_window()           -> window folded into the LS
+//   free_decay aborted:     abort_window()         -> window dropped
 //   at a slow rate (e.g. after each window):  solve_and_accept()
 //   each 1 kHz tick:        step_output(theta_A, a_B/a_A, dt, excitation_on)
 //                           -> angle correction (input-axis rad) to add to
@@ -51,6 +52,11 @@ class Estimator {
     return window_.begin_window(t_switch_s);
   }
   Status add_sample(const WaveSample& s) { return window_.add_sample(s); }
+  // Drops the open window without folding it (a fault during the free decay).
+  void abort_window() {
+    window_.abort_window();
+    control_.restart();
+  }
   // Folds the window into the normal equations; Status::too_short etc. drop it.
   Status end_window();
   // Solves the configured variant; the model used for compensation changes
