@@ -246,6 +246,67 @@ void read_effects(Section s, Effects& fx) {
   s.finish();
 }
 
+void read_resonator(Section s, SimConfig& c) {
+  auto& r = c.resonator;
+  r.f_hz = s.number("f_hz", 1.0, 1e6, r.f_hz, "Hz");
+  r.q = s.number("q", 1e2, 1e10, r.q, "");
+  r.dmu = s.number("dmu", -0.5, 0.5, r.dmu, "");
+  r.th_mu_rad = s.number("th_mu_deg", -180.0, 180.0, r.th_mu_rad / kDegToRad, "deg") * kDegToRad;
+  r.split_hz = s.number("split_hz", -10.0, 10.0, r.split_hz, "Hz");
+  r.th_w_rad = s.number("th_w_deg", -180.0, 180.0, r.th_w_rad / kDegToRad, "deg") * kDegToRad;
+  r.angular_gain = s.number("angular_gain", 0.01, 2.0, r.angular_gain, "");
+  r.temp_ref_c = s.number("temp_ref_c", -100.0, 200.0, r.temp_ref_c, "degC");
+  s.finish();
+}
+
+void read_electrodes(Section s, SimConfig& c) {
+  auto& e = c.electrodes;
+  e.pump_gain_per_s2_v2 =
+      s.number("pump_gain_per_s2_v2", 0.0, 1e6, e.pump_gain_per_s2_v2, "1/(s^2 V^2)");
+  e.eps_p = s.number("eps_p", -0.5, 0.5, e.eps_p, "");
+  e.eps_q = s.number("eps_q", -0.5, 0.5, e.eps_q, "");
+  e.forcer_gain_per_s2 = s.number("forcer_gain_per_s2", 0.0, 1e6, e.forcer_gain_per_s2, "1/s^2");
+  s.finish();
+}
+
+void read_initial(Section s, SimConfig& c) {
+  c.initial.amplitude_v = s.number("amplitude_v", 0.0, 100.0, c.initial.amplitude_v, "V");
+  c.initial.theta_rad = s.number("theta_deg", -180.0, 180.0, 0.0, "deg") * kDegToRad;
+  c.initial.quad_v = s.number("quad_v", -100.0, 100.0, c.initial.quad_v, "V");
+  s.finish();
+}
+
+void read_adc(Section s, SimConfig& c) {
+  auto& a = c.adc;
+  a.sample_rate_hz =
+      static_cast<uint32_t>(s.integer("sample_rate_hz", 1000, 10'000'000, a.sample_rate_hz, "Hz"));
+  a.block_frames = static_cast<uint32_t>(s.integer("block_frames", 1, 100'000, a.block_frames, ""));
+  a.bits = static_cast<uint32_t>(s.integer("bits", 2, 32, a.bits, ""));
+  a.full_scale_v = s.number("full_scale_v", 1e-3, 1000.0, a.full_scale_v, "V");
+  a.noise_v_rms[0] = s.number("noise_x_v_rms", 0.0, 10.0, a.noise_v_rms[0], "V");
+  a.noise_v_rms[1] = s.number("noise_y_v_rms", 0.0, 10.0, a.noise_v_rms[1], "V");
+  a.offset_v[0] = s.number("offset_x_v", -10.0, 10.0, a.offset_v[0], "V");
+  a.offset_v[1] = s.number("offset_y_v", -10.0, 10.0, a.offset_v[1], "V");
+  s.finish();
+}
+
+void read_dac(Section s, SimConfig& c) {
+  auto& d = c.dac;
+  d.bits = static_cast<uint32_t>(s.integer("bits", 2, 32, d.bits, ""));
+  d.full_scale_v = s.number("full_scale_v", 1e-3, 1000.0, d.full_scale_v, "V");
+  d.latency_samples =
+      static_cast<uint32_t>(s.integer("latency_samples", 0, 100'000, d.latency_samples, "samples"));
+  s.finish();
+}
+
+void read_can(Section s, SimConfig& c) {
+  c.can.tx_queue_frames =
+      static_cast<uint32_t>(s.integer("tx_queue_frames", 1, 4096, c.can.tx_queue_frames, "frames"));
+  c.can.tx_frames_per_ms = static_cast<uint32_t>(
+      s.integer("tx_frames_per_ms", 1, 1000, c.can.tx_frames_per_ms, "frames/ms"));
+  s.finish();
+}
+
 }  // namespace
 
 SimConfig parse_scenario(std::string_view toml_text, const std::string& source,
@@ -262,69 +323,12 @@ SimConfig parse_scenario(std::string_view toml_text, const std::string& source,
   SimConfig c;
   Section top(&root, "", source);
   c.seed = top.integer("seed", 0, std::numeric_limits<int64_t>::max(), c.seed, "");
-
-  {
-    Section s = top.sub("resonator");
-    auto& r = c.resonator;
-    r.f_hz = s.number("f_hz", 1.0, 1e6, r.f_hz, "Hz");
-    r.q = s.number("q", 1e2, 1e10, r.q, "");
-    r.dmu = s.number("dmu", -0.5, 0.5, r.dmu, "");
-    r.th_mu_rad = s.number("th_mu_deg", -180.0, 180.0, r.th_mu_rad / kDegToRad, "deg") * kDegToRad;
-    r.split_hz = s.number("split_hz", -10.0, 10.0, r.split_hz, "Hz");
-    r.th_w_rad = s.number("th_w_deg", -180.0, 180.0, r.th_w_rad / kDegToRad, "deg") * kDegToRad;
-    r.angular_gain = s.number("angular_gain", 0.01, 2.0, r.angular_gain, "");
-    r.temp_ref_c = s.number("temp_ref_c", -100.0, 200.0, r.temp_ref_c, "degC");
-    s.finish();
-  }
-  {
-    Section s = top.sub("electrodes");
-    auto& e = c.electrodes;
-    e.pump_gain_per_s2_v2 =
-        s.number("pump_gain_per_s2_v2", 0.0, 1e6, e.pump_gain_per_s2_v2, "1/(s^2 V^2)");
-    e.eps_p = s.number("eps_p", -0.5, 0.5, e.eps_p, "");
-    e.eps_q = s.number("eps_q", -0.5, 0.5, e.eps_q, "");
-    e.forcer_gain_per_s2 = s.number("forcer_gain_per_s2", 0.0, 1e6, e.forcer_gain_per_s2, "1/s^2");
-    s.finish();
-  }
-  {
-    Section s = top.sub("initial");
-    c.initial.amplitude_v = s.number("amplitude_v", 0.0, 100.0, c.initial.amplitude_v, "V");
-    c.initial.theta_rad = s.number("theta_deg", -180.0, 180.0, 0.0, "deg") * kDegToRad;
-    c.initial.quad_v = s.number("quad_v", -100.0, 100.0, c.initial.quad_v, "V");
-    s.finish();
-  }
-  {
-    Section s = top.sub("adc");
-    auto& a = c.adc;
-    a.sample_rate_hz = static_cast<uint32_t>(
-        s.integer("sample_rate_hz", 1000, 10'000'000, a.sample_rate_hz, "Hz"));
-    a.block_frames =
-        static_cast<uint32_t>(s.integer("block_frames", 1, 100'000, a.block_frames, ""));
-    a.bits = static_cast<uint32_t>(s.integer("bits", 2, 32, a.bits, ""));
-    a.full_scale_v = s.number("full_scale_v", 1e-3, 1000.0, a.full_scale_v, "V");
-    a.noise_v_rms[0] = s.number("noise_x_v_rms", 0.0, 10.0, a.noise_v_rms[0], "V");
-    a.noise_v_rms[1] = s.number("noise_y_v_rms", 0.0, 10.0, a.noise_v_rms[1], "V");
-    a.offset_v[0] = s.number("offset_x_v", -10.0, 10.0, a.offset_v[0], "V");
-    a.offset_v[1] = s.number("offset_y_v", -10.0, 10.0, a.offset_v[1], "V");
-    s.finish();
-  }
-  {
-    Section s = top.sub("dac");
-    auto& d = c.dac;
-    d.bits = static_cast<uint32_t>(s.integer("bits", 2, 32, d.bits, ""));
-    d.full_scale_v = s.number("full_scale_v", 1e-3, 1000.0, d.full_scale_v, "V");
-    d.latency_samples = static_cast<uint32_t>(
-        s.integer("latency_samples", 0, 100'000, d.latency_samples, "samples"));
-    s.finish();
-  }
-  {
-    Section s = top.sub("can");
-    c.can.tx_queue_frames = static_cast<uint32_t>(
-        s.integer("tx_queue_frames", 1, 4096, c.can.tx_queue_frames, "frames"));
-    c.can.tx_frames_per_ms = static_cast<uint32_t>(
-        s.integer("tx_frames_per_ms", 1, 1000, c.can.tx_frames_per_ms, "frames/ms"));
-    s.finish();
-  }
+  read_resonator(top.sub("resonator"), c);
+  read_electrodes(top.sub("electrodes"), c);
+  read_initial(top.sub("initial"), c);
+  read_adc(top.sub("adc"), c);
+  read_dac(top.sub("dac"), c);
+  read_can(top.sub("can"), c);
   c.rate_rad_s = read_profile(top.sub("rate"), "dps", kDegToRad, -1e4, 1e4, 0.0, base_dir);
   c.temp_c = read_profile(top.sub("temperature"), "c", 1.0, -100.0, 200.0, c.resonator.temp_ref_c,
                           base_dir);
