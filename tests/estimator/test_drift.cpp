@@ -213,3 +213,37 @@ TEST(ControlDrift, EstimatorKeepsNoModelFromIllConditionedWindows) {
   // the scheduler is pointed away from the one covered bin
   CHECK(coverage_bin(est.least_covered_theta_rad()) != coverage_bin(0.3));
 }
+
+TEST(ControlDrift, PumpGapHarmonicsComeOutOfThePumpEffortOnSyntheticDecay) {
+  // GIVEN eq. 3 with the ring pump of eqs. 25-27: a_A' = (-nu - dnu(th) +
+  // c V0^2 cos(eps) (1 + e_p cos4th + e_q sin4th)) a_A, the pattern turning at
+  // 0.2 rad/s, V0 near the balance with a 2 % ripple (no noise)
+  const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  const double c = 3.49e-4, e_p = 0.01, e_q = -0.004, eps = 0.05;
+  PumpDriftEstimator est;
+  est.set_model(p);
+  double aA = 1.0, th = 0.0;
+  const double dt = 1e-3;
+  bool all_taken = true;
+  for (int i = 0; i < 60000; ++i) {
+    const double t = i * dt;
+    const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
+    const double dnu = p(kDnuC) * c4 + p(kDnuS) * s4;
+    // The AGC keeps the mean balance; its ripple leaves a_A moving a little.
+    const double v0 = std::sqrt(p(kNu) / (c * std::cos(eps))) * (1.0 + 0.02 * std::sin(0.7 * t));
+    const double w = v0 * v0 * std::cos(eps);
+    all_taken = est.add_sample({t, aA, 0.0, th, eps, 0, 0, v0}) && all_taken;
+    aA *= std::exp(dt * (-p(kNu) - dnu + c * w * (1 + e_p * c4 + e_q * s4)));
+    th += 0.2 * dt;
+  }
+  CHECK(all_taken);
+  CHECK(est.valid());
+  const Eigen::Vector3d b = est.coefficients();
+  // THEN (c, c e_p, c e_q) are recovered and D_Phi = w (b2 cos4th - b1 sin4th)
+  DOUBLES_EQUAL(c, b(0), 1e-4 * c);
+  DOUBLES_EQUAL(e_p, b(1) / b(0), 1e-4);
+  DOUBLES_EQUAL(e_q, b(2) / b(0), 1e-4);
+  // AND a break between segments (a free-decay window) keeps the fit
+  est.restart();
+  CHECK(est.valid());
+}
