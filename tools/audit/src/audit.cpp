@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <stdexcept>
 
@@ -82,7 +83,7 @@ bool Auditor::testable(Effect e) const {
     case Effect::thermal_frequency:
     case Effect::thermal_damping: return d_.has_temp && d_.temp_span_c > 0.02;
     case Effect::electrostatic_spring:
-      return d_.has_pump && d_.forced.size() >= 3 && eo_.forced_sigma_rad_s > 0.0;
+      return d_.has_pump && d_.forced.size() >= 3 && eo_.use_forced;
     case Effect::drive_feedthrough: return d_.edges.size() >= 3;
     default: return true;
   }
@@ -249,20 +250,37 @@ AuditResult Auditor::run(PlotData* plot) {
   // join with their scatter as weight.
   State cur = fit_state(base, p0, false);
   if (d_.forced.size() >= 3) {
-    auto fr = forced_residuals(d_, cur.fit.p);
-    std::vector<double> dev(fr);
-    std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(dev.size() / 2),
-                     dev.end());
-    const double med = dev[dev.size() / 2];
+    // Weight of each excitation segment: its white-noise error and the
+    // scatter the baseline leaves beyond it (robust, about the median so that
+    // a common offset, the spring's signature, does not count as scatter).
+    const auto fr = forced_residuals(d_, cur.fit.p);
+    std::vector<double> dev(fr), se2;
+    auto median = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      return v[v.size() / 2];
+    };
+    const double med = median(dev);
     for (auto& v : dev)
       v = std::abs(v - med);
-    std::nth_element(dev.begin(), dev.begin() + static_cast<std::ptrdiff_t>(dev.size() / 2),
-                     dev.end());
-    double se = 0.0;
     for (const auto& f : d_.forced)
-      se = std::max(se, f.se_rad_s);
-    eo_.forced_sigma_rad_s = std::max(1.4826 * dev[dev.size() / 2], se);
+      se2.push_back(f.se_rad_s * f.se_rad_s);
+    const double mad = 1.4826 * median(dev);
+    const double extra2 = std::max(0.0, mad * mad - median(se2));
+    for (auto& f : d_.forced)
+      f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
+    eo_.use_forced = true;
     cur = fit_state(base, cur.fit.p, false);
+  }
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    const auto fr = forced_residuals(d_, cur.fit.p);
+    for (std::size_t i = 0; i < fr.size(); ++i) {
+      const auto& f = d_.forced[i];
+      std::fprintf(stderr,
+                   "forced %zu t=%.2f-%.2f res=%.3g rad/s sigma=%.3g se=%.3g v2=%.3g T=%.3f\n", i,
+                   f.t0_s, f.t1_s, fr[i], f.sigma_rad_s, f.se_rad_s, f.mean_v2, f.mean_temp_c);
+    }
+    std::fprintf(stderr, "baseline chi2 %.1f n %zu kappa %.3f\n", cur.fit.chi2, cur.fit.n_res,
+                 cur.kappa);
   }
   const State baseline = cur;
   out.noise_v = d_.noise_v;
@@ -409,12 +427,12 @@ AuditResult Auditor::run(PlotData* plot) {
     f.impact = impact(chosen[i], f.value, cur.fit.p);
     out.findings.push_back(f);
   }
-  out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.forced_sigma_rad_s, ft);
+  out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.use_forced, ft);
 
   // Structure left after the selected model.
   const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
   if (ratio > opt_.unexplained_ratio) {
-    const auto left = locate(d_, cur.fit.p, cur.res, eo_.forced_sigma_rad_s,
+    const auto left = locate(d_, cur.fit.p, cur.res, eo_.use_forced,
                              feedthrough_stat(d_, cur.fit.p, ln_neff(cur)));
     char buf[200];
     std::snprintf(buf, sizeof buf,

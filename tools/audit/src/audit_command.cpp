@@ -95,7 +95,10 @@ void bench_usage(std::FILE* f) {
                "alternately) with sim_target; each gives one null recording and one recording\n"
                "per catalogue effect concealed at 0.3x-3x its detection threshold. Prints the\n"
                "confusion matrix, the hit rate above 2x, the false-finding rate on nulls and the\n"
-               "confusable pairs, then times the audit of an H-hour 200 Hz recording (0: skip).\n");
+               "confusable pairs, then times the audit of an H-hour 200 Hz recording (0: skip).\n\n"
+               "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry]\n"
+               "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
+               "writes one simulated campaign, optionally with one catalogue effect.\n");
 }
 
 double speed_run(double hours, uint64_t seed) {
@@ -121,6 +124,8 @@ double speed_run(double hours, uint64_t seed) {
 int audit_bench_main(std::span<char* const> args) {
   BenchOptions o;
   double hours = 1.0;
+  std::string emit, design = "ringdown", effect;
+  double duration_s = 480.0, value = 0.0, noise_v = -1.0;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
     const bool has_value = i + 1 < args.size();
@@ -133,6 +138,17 @@ int audit_bench_main(std::span<char* const> args) {
       o.seed = std::strtoull(args[++i], nullptr, 10);
     } else if (a == "--speed-hours" && has_value) {
       hours = std::atof(args[++i]);
+    } else if (a == "--emit" && has_value) {
+      emit = args[++i];
+    } else if (a == "--design" && has_value) {
+      design = args[++i];
+    } else if (a == "--noise" && has_value) {
+      noise_v = std::atof(args[++i]);
+    } else if (a == "--duration" && has_value) {
+      duration_s = std::atof(args[++i]);
+    } else if (a == "--effect" && i + 2 < args.size()) {
+      effect = args[++i];
+      value = std::atof(args[++i]);
     } else if (a == "--verbose") {
       o.verbose = true;
     } else {
@@ -140,6 +156,22 @@ int audit_bench_main(std::span<char* const> args) {
       bench_usage(stderr);
       return 2;
     }
+  }
+  if (!emit.empty()) {
+    // One simulated campaign written as a recording (for looking at by hand).
+    auto sc = bench::random_scenario(
+        design == "telemetry" ? bench::Design::telemetry : bench::Design::ringdown, duration_s,
+        o.seed);
+    if (!effect.empty() && !bench::conceal_by_id(sc, effect, value, o.seed)) {
+      std::fprintf(stderr, "hrg audit-bench: unknown effect '%s'\n", effect.c_str());
+      return 2;
+    }
+    if (noise_v >= 0.0) sc.noise_v = noise_v;
+    recording::write_recording(emit, bench::simulate(sc));
+    std::printf("wrote %s (f %.6f Hz, Q %.4g, dmu %.4g, split %.4g Hz, noise %.3g V)\n",
+                emit.c_str(), sc.resonator.f_hz, sc.resonator.q, sc.resonator.dmu,
+                sc.resonator.split_hz, sc.noise_v);
+    return 0;
   }
   if (o.designs < 0) {
     std::fprintf(stderr, "hrg audit-bench: --n must not be negative\n");

@@ -41,6 +41,21 @@ void conceal(Scenario& s, Effect e, double v, std::mt19937_64& g) {
   }
 }
 
+}  // namespace
+
+bool bench::conceal_by_id(Scenario& s, const std::string& id, double value, uint64_t seed) {
+  std::mt19937_64 g(seed);
+  for (const auto& info : effect_table()) {
+    if (id == info.id) {
+      conceal(s, info.effect, value, g);
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+
 int top_of(const AuditResult& r, double& value) {
   if (r.findings.empty()) return -1;
   value = r.findings.front().value;
@@ -94,6 +109,17 @@ BenchResult run_benchmark(const BenchOptions& o) {
       const double sign = u(g) < 0.5 ? -1.0 : 1.0;
       c.true_value = sign * c.strength * cand.threshold;
       if (cand.effect == Effect::drive_feedthrough) c.true_value = std::abs(c.true_value);
+      // Keep the damping physical: it may change by at most half over the
+      // campaign's amplitude or temperature range. A design whose threshold
+      // lies beyond that cannot reveal the effect and is not scored.
+      const double a_max = 1.3 * base.amplitude_v;
+      if ((cand.effect == Effect::nonlinear_damping &&
+           std::abs(c.true_value) * a_max * a_max > 0.5) ||
+          (cand.effect == Effect::thermal_damping &&
+           std::abs(c.true_value) * base.temp_swing_c > 0.5)) {
+        ++res.unscored;
+        continue;
+      }
       Scenario s = base;
       conceal(s, cand.effect, c.true_value, g);
       const auto [r, secs] = timed_audit(bench::simulate(s));
@@ -159,6 +185,10 @@ std::string format_benchmark(const BenchResult& r) {
   o += buf;
   std::snprintf(buf, sizeof buf, "Found below 1x threshold (for reference): %d/%d\n",
                 r.below1x_found, r.below1x);
+  o += buf;
+  std::snprintf(buf, sizeof buf,
+                "Not scored (threshold beyond a physical damping change in that design): %d\n",
+                r.unscored);
   o += buf;
   // Confusable pairs of the catalogue.
   struct Pair {

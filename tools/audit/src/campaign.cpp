@@ -36,7 +36,7 @@ std::vector<Segment> plan(const Scenario& s, std::mt19937_64& g) {
     if (s.design == Design::ringdown) {
       rate =
           uniform(g, 0, 1) < 0.4 ? 0.0 : uniform(g, 3.0, 20.0) * (uniform(g, 0, 1) < 0.5 ? -1 : 1);
-      out.push_back({true, 3.0, rate, true, uniform(g, -kPi / 4, kPi / 4)});
+      out.push_back({true, 4.0, rate, true, uniform(g, -kPi / 6, kPi / 6)});
       double free_s = uniform(g, 10.0, 30.0);
       if (!long_done && t > 0.3 * s.duration_s) {
         free_s = std::min(200.0, 0.3 * s.duration_s);
@@ -44,7 +44,7 @@ std::vector<Segment> plan(const Scenario& s, std::mt19937_64& g) {
         long_done = true;
       }
       out.push_back({false, free_s, rate, false, 0.0});
-      t += 3.0 + free_s;
+      t += 4.0 + free_s;
     } else {
       if (out.empty() || uniform(g, 0, 1) < 0.25) {
         rate = uniform(g, -30.0, 30.0);
@@ -96,11 +96,14 @@ recording::Recording simulate(const Scenario& s) {
   m.set_temperature_profile(
       sim::Profile::sine(s.temp_swing_c, 1.0 / (1.3 * s.duration_s), uniform(g, 0.0, 2.0 * kPi))
           .add_offset(s.temp_mean_c));
+  // Rate steps exactly at the sample where their segment starts.
+  const double dt = 1.0 / s.sample_rate_hz;
   std::vector<sim::ProfilePoint> rate_points;
-  double t = 0.0;
+  long long k0 = 0;
   for (const auto& seg : segs) {
-    rate_points.push_back({t, seg.rate_dps * kPi / 180.0 + sim::kEarthRateRadS * 0.6});
-    t += seg.duration_s;
+    rate_points.push_back({static_cast<double>(k0) * dt - 0.5 * dt,
+                           seg.rate_dps * kPi / 180.0 + sim::kEarthRateRadS * 0.6});
+    k0 += std::llround(seg.duration_s / dt);
   }
   m.set_rate_profile(sim::Profile::steps(rate_points));
   m.set_standing_wave(s.amplitude_v, uniform(g, -kPi / 4, kPi / 4), 0.0, 0.0);
@@ -109,7 +112,6 @@ recording::Recording simulate(const Scenario& s) {
       s.resonator.angular_gain);
   rec.set_metadata("source", s.design == Design::ringdown ? "audit benchmark ring-down campaign"
                                                           : "audit benchmark telemetry");
-  const double dt = 1.0 / s.sample_rate_hz;
   const double w = s.resonator.omega_rad_s();
   const double nu = s.resonator.nu_per_s();
   const double kpump = s.electrodes.pump_gain_per_s2_v2;
@@ -117,6 +119,7 @@ recording::Recording simulate(const Scenario& s) {
   const double sensor_temp_noise = 0.003;
   std::normal_distribution<double> tnoise(0.0, sensor_temp_noise);
   double time = 0.0;
+  double target = 0.0;
   std::size_t k = 0;
   for (const auto& seg : segs) {
     const auto n = static_cast<std::size_t>(std::llround(seg.duration_s / dt));
@@ -136,8 +139,10 @@ recording::Recording simulate(const Scenario& s) {
         const double c2 = std::cos(2.0 * wv.theta_rad), s2 = std::sin(2.0 * wv.theta_rad);
         double theta_rate = 0.0;
         if (seg.move_pattern) {
-          const double err = std::remainder(seg.target_rad - wv.theta_rad, kPi / 2.0);
-          theta_rate = std::clamp(3.0 * err, -0.1, 0.1);
+          // Target relative to where the segment started (a move of up to 30 deg).
+          if (i == 0) target = wv.theta_rad + seg.target_rad;
+          const double err = std::remainder(target - wv.theta_rad, kPi / 2.0);
+          theta_rate = std::clamp(6.0 * err, -0.5, 0.5);
         }
         const sim::cplx u_perp = 2.0 * a * theta_rate + kI * 5.0 * wv.a_b_v;
         drive.forcer_x_v = kI * 2.0 * w * (u_perp * (-s2)) / gf;

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <random>
+#include <string>
 
 #include "recording/recording.hpp"
 #include "sim_target/params.hpp"
@@ -36,6 +37,11 @@ struct Scenario {
 
 // A random resonator, noise and campaign of the given design (effects off).
 Scenario random_scenario(Design design, double duration_s, uint64_t seed);
+
+// Turns on catalogue effect `id` with catalogue value `value` (feedthrough:
+// the larger pickoff; the other pickoff and the phases are drawn from `seed`).
+// False for an unknown id.
+bool conceal_by_id(Scenario& s, const std::string& id, double value, uint64_t seed);
 
 // Simulates the campaign and returns the recording (deterministic in seed).
 recording::Recording simulate(const Scenario& s);

@@ -169,20 +169,46 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
     const std::size_t len = r.last - r.first + 1;
     if (r.exc) {
       if (len < kMinForcedSamples) continue;
+      // Only the quiet part of an excitation segment tells the frequency: the
+      // quadrature nulled and the pattern not being moved by the forcers. With
+      // a quadrature a_B the forces that steer the pattern pull the wave phase
+      // by -2 (a_B/a_A) theta'_cmd, which no resonator parameter explains.
+      const std::size_t h = 10;
+      std::size_t best_first = 0, best_len = 0, run_first = 0, run_len = 0;
+      for (std::size_t i = r.first; i <= r.last; ++i) {
+        bool ok = i >= r.first + h && i + h <= r.last;
+        if (ok) {
+          const double a = std::sqrt(a2[i]);
+          const auto w = dsp::wave_variables<double>({cx[i], sx[i], cy[i], sy[i]});
+          const double th_rate = (theta[i + h] - theta[i - h]) / (t[i + h] - t[i - h]);
+          const double free_rate = rate ? -0.5 * d.angular_gain * (*rate)[i] * kPi / 180.0 : 0.0;
+          ok = std::abs(w.a_B) < 1e-3 * a + 3.0 * d.noise_v && std::abs(th_rate - free_rate) < 2e-3;
+        }
+        if (ok) {
+          if (run_len == 0) run_first = i;
+          ++run_len;
+          if (run_len > best_len) best_len = run_len, best_first = run_first;
+        } else {
+          run_len = 0;
+        }
+      }
+      const double dt_typ = rec.typical_step_s();
+      if (best_len < 20 || static_cast<double>(best_len) * dt_typ < 0.5) continue;
+      const std::size_t q0 = best_first, q1 = best_first + best_len - 1;
       ForcedSegment f;
-      f.first_row = r.first;
-      f.last_row = r.last;
+      f.first_row = q0;
+      f.last_row = q1;
       const std::size_t k = 3;
       double ts = 0, te = 0, ps = 0, pe = 0;
       for (std::size_t j = 0; j < k; ++j) {
-        ts += t[r.first + j] / k, ps += phase[r.first + j] / k;
-        te += t[r.last - j] / k, pe += phase[r.last - j] / k;
+        ts += t[q0 + j] / k, ps += phase[q0 + j] / k;
+        te += t[q1 - j] / k, pe += phase[q1 - j] / k;
       }
       f.t0_s = ts;
       f.t1_s = te;
       f.freq_rad_s = (pe - ps) / (te - ts);
       double c4 = 0, s4 = 0, v2 = 0, aa = 0, tc = 0, rr = 0;
-      for (std::size_t i = r.first; i <= r.last; ++i) {
+      for (std::size_t i = q0; i <= q1; ++i) {
         c4 += std::cos(4.0 * theta[i]);
         s4 += std::sin(4.0 * theta[i]);
         v2 += pump ? (*pump)[i] * (*pump)[i] : 0.0;
@@ -190,11 +216,11 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
         tc += temp ? (*temp)[i] : 0.0;
         rr += rate ? (*rate)[i] * kPi / 180.0 : 0.0;
       }
-      const auto m = static_cast<double>(len);
+      const auto m = static_cast<double>(best_len);
       f.mean_c4 = c4 / m, f.mean_s4 = s4 / m, f.mean_v2 = v2 / m, f.mean_a2 = aa / m;
       f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
-      f.theta0_rad = theta[r.first];
-      f.theta1_rad = theta[r.last];
+      f.theta0_rad = theta[q0];
+      f.theta1_rad = theta[q1];
       f.se_rad_s =
           std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
       d.forced.push_back(f);

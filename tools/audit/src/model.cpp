@@ -25,8 +25,11 @@ struct Inputs {
 // Dynamics matrix of the model for one set of slow inputs.
 Mat2 dynamics(const Params& p, const Dataset& d, const Inputs& in) {
   const double dT = in.temp_c - d.temp_ref_c;
-  const double dw0 =
-      p[kDw0] + 2.0 * kPi * p[kDuff] * in.a2_v2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
+  // Both circular modes of eq. 1 ring at sqrt(w^2 + (Omega K)^2) -+ Omega K:
+  // the common second-order shift (Omega K)^2 / 2w moves the phase.
+  const double ok2 = in.rate_rad_s * p[kK] * in.rate_rad_s * p[kK];
+  const double dw0 = p[kDw0] + ok2 / (4.0 * kPi * d.f_ref_hz) + 2.0 * kPi * p[kDuff] * in.a2_v2 +
+                     2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
   const double s = (1.0 + p[kNld] * in.a2_v2) * (1.0 + p[kTd] * dT);
   const double ok = in.rate_rad_s * p[kK];
   return {kI * (dw0 + p[kDwC]) - s * (p[kNu] + p[kDnuC]), kI * p[kDwS] - s * p[kDnuS] + ok,
@@ -133,9 +136,10 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
   r.reserve(d.forced.size());
   for (const auto& f : d.forced) {
     const double dT = f.mean_temp_c - d.temp_ref_c;
-    double w = p[kDw0] + p[kDwC] * f.mean_c4 + p[kDwS] * f.mean_s4 +
-               2.0 * kPi * p[kDuff] * f.mean_a2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT +
-               2.0 * kPi * p[kEs] * f.mean_v2;
+    const double okf = f.mean_rate_rad_s * p[kK];
+    double w = p[kDw0] + okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
+               p[kDwS] * f.mean_s4 + 2.0 * kPi * p[kDuff] * f.mean_a2 +
+               2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT + 2.0 * kPi * p[kEs] * f.mean_v2;
     double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);
     dm = std::remainder(dm, kPi);
     w += dm / (f.t1_s - f.t0_s);
@@ -173,9 +177,10 @@ void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vect
       if (pred) (*pred)[s.first_block + k] = {px, py};
     }
   }
-  if (o.forced_sigma_rad_s > 0.0 && !o.heldout_only) {
-    for (double r : forced_residuals(d, p))
-      res.push_back(r / o.forced_sigma_rad_s);
+  if (o.use_forced && !o.heldout_only) {
+    const auto fr = forced_residuals(d, p);
+    for (std::size_t i = 0; i < fr.size(); ++i)
+      res.push_back(fr[i] / d.forced[i].sigma_rad_s);
   }
 }
 

@@ -44,13 +44,13 @@ using Mask = std::array<bool, kParamCount>;
 double param_scale(int p);
 
 struct EvalOptions {
-  bool include_heldout = true;      // fit segments marked heldout too
-  bool heldout_only = false;        // residuals of held-out segments, state from their first 20 %
-  double forced_sigma_rad_s = 0.0;  // 0: excitation segments not used
+  bool include_heldout = true;  // fit segments marked heldout too
+  bool heldout_only = false;    // residuals of held-out segments, state from their first 20 %
+  bool use_forced = false;      // add the excitation-segment frequencies (weights sigma_rad_s)
 };
 
 // Residual vector in units of the noise: 4 per block (re/im of x, y) scaled
-// by sqrt(n)/noise, then one per excitation segment (frequency, / sigma).
+// by sqrt(n)/noise, then one per excitation segment (frequency / sigma_rad_s).
 // `pred`, when given, receives the predicted measured block means (x, y).
 void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vector<double>& res,
               std::vector<std::array<cplx, 2>>* pred = nullptr);

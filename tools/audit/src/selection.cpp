@@ -99,6 +99,26 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   if (used.size() < 3) return fs;
   for (const auto* e : used)
     jumps.push_back(edge_jump(d, p, *e));
+  // A switch-off in the middle of a control transient is not evidence either:
+  // drop edges far outside the others (a real feedthrough, proportional to
+  // the pump voltage, raises all of them together).
+  {
+    std::vector<double> q;
+    for (const auto& ej : jumps)
+      q.push_back(ej.j.squaredNorm() / ej.var);
+    std::vector<double> qs(q);
+    std::nth_element(qs.begin(), qs.begin() + static_cast<std::ptrdiff_t>(qs.size() / 2), qs.end());
+    const double limit = std::max(30.0, 10.0 * qs[qs.size() / 2]);
+    std::vector<EdgeJump> kept;
+    std::vector<const Edge*> kept_edges;
+    for (std::size_t i = 0; i < jumps.size(); ++i) {
+      if (q[i] <= limit) kept.push_back(jumps[i]), kept_edges.push_back(used[i]);
+    }
+    fs.dropped = static_cast<int>(jumps.size() - kept.size());
+    jumps.swap(kept);
+    used.swap(kept_edges);
+    if (jumps.size() < 3) return fs;
+  }
   if (std::getenv("HRG_AUDIT_DEBUG")) {
     for (std::size_t i = 0; i < jumps.size(); ++i) {
       std::fprintf(stderr, "edge %zu t=%.3f |J|/sd=%.2f V=%.2f J=%s\n", i,
@@ -175,7 +195,7 @@ double effective_fraction(const std::vector<double>& res, std::size_t n_free_res
 }
 
 std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
-                             double forced_sigma, const FeedStat& ft) {
+                             bool use_forced, const FeedStat& ft) {
   std::vector<Location> out;
   // Per free segment: excess chi^2 over its degrees of freedom.
   std::size_t k = 0;
@@ -259,14 +279,15 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
                    hq[0]});
   }
   // Excitation segments: mean frequency offset while the pump is on.
-  if (forced_sigma > 0.0 && !d.forced.empty()) {
+  if (use_forced && !d.forced.empty()) {
     const auto fr = forced_residuals(d, p);
-    double m = 0.0, v2 = 0.0;
-    for (std::size_t i = 0; i < fr.size(); ++i)
-      m += fr[i], v2 += d.forced[i].mean_v2;
-    m /= static_cast<double>(fr.size());
-    v2 /= static_cast<double>(fr.size());
-    const double chi = m * m * static_cast<double>(fr.size()) / (forced_sigma * forced_sigma);
+    double m = 0.0, v2 = 0.0, wsum = 0.0;
+    for (std::size_t i = 0; i < fr.size(); ++i) {
+      const double w = 1.0 / (d.forced[i].sigma_rad_s * d.forced[i].sigma_rad_s);
+      m += w * fr[i], v2 += d.forced[i].mean_v2 / static_cast<double>(fr.size()), wsum += w;
+    }
+    m /= wsum;
+    const double chi = m * m * wsum;
     if (chi > 25.0) {
       out.push_back({"wave frequency",
                      fmt("excitation segments (pump on, mean pump_v^2 %.3g V^2): %.3g mHz "

@@ -20,6 +20,7 @@ struct FeedStat {
   double sigma = 0.0;           // of the larger |c_k|
   double threshold = 0.0;       // |c| at which the expected delta BIC is zero
   int edges = 0;
+  int dropped = 0;  // switch-offs left out as control transients
 };
 
 // Jumps of the measured envelopes at the switching instants, against the
@@ -31,6 +32,6 @@ double effective_fraction(const std::vector<double>& res, std::size_t n_free_res
 
 // Where the model misfits, strongest first.
 std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
-                             double forced_sigma, const FeedStat& ft);
+                             bool use_forced, const FeedStat& ft);
 
 }  // namespace hrg::audit::detail

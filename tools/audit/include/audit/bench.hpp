@@ -40,6 +40,7 @@ struct BenchResult {
   int above2x = 0, above2x_hits = 0;  // hit = top finding right and parameter within 20 %
   int nulls = 0, null_findings = 0;
   int below1x = 0, below1x_found = 0;
+  int unscored = 0;  // cases whose threshold is beyond a physical strength
   double mean_audit_s = 0.0;
 };
 
