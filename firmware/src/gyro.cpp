@@ -194,7 +194,14 @@ void Gyro::task_identify(Gyro& g) {
 
 void Gyro::task_output(Gyro& g) {
   const ChainOutputs& o = g.status_.chain;
-  const bool moving_on_purpose = g.status_.pattern_control;
+  // The output is held while the pattern is moved on purpose, and for a
+  // short time after (the demodulator still shows the end of the move).
+  const bool moving_on_purpose = g.status_.pattern_control || g.pattern_hold_frames_ > 0;
+  if (g.status_.pattern_control) {
+    g.pattern_hold_frames_ = kPatternHoldFrames;
+  } else if (g.pattern_hold_frames_ > 0) {
+    --g.pattern_hold_frames_;
+  }
   if (moving_on_purpose) g.output_.rereference();
   const double ratio = o.a_a_v > 0.0 ? o.a_b_v / o.a_a_v : 0.0;
   // The model is applied once the campaign has ended (conditioning and

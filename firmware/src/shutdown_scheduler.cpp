@@ -86,21 +86,44 @@ WindowDecision ShutdownScheduler::step(Mode mode, double theta_rad, double theta
     counts_ = {};
     done_ = false;
   }
-  if (mode != Mode::operate || since_start_ < cfg_.period_frames) return d;
-  const uint32_t bin = bin_of(theta_rad);
-  const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
-  if (under_covered(bin) || (!is_static && since_start_ >= cfg_.max_wait_frames) ||
-      (is_static && !cfg_.rotate_on_static_base && since_start_ >= cfg_.max_wait_frames)) {
-    d.open = true;
-    in_window_ = true;
-    in_window_frames_ = 0;
-    window_bin_ = bin;
-    since_start_ = 0;
+  if (mode != Mode::operate) {
+    moving_ = false;
     return d;
   }
-  if (is_static && cfg_.rotate_on_static_base) {
+  const uint32_t bin = bin_of(theta_rad);
+  if (since_start_ >= cfg_.period_frames) {
+    const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
+    if (under_covered(bin) || (!is_static && !moving_ && since_start_ >= cfg_.max_wait_frames) ||
+        (is_static && !cfg_.rotate_on_static_base && since_start_ >= cfg_.max_wait_frames)) {
+      d.open = true;
+      in_window_ = true;
+      in_window_frames_ = 0;
+      window_bin_ = bin;
+      since_start_ = 0;
+      moving_ = false;
+      return d;
+    }
+    if (!moving_ && is_static && cfg_.rotate_on_static_base) {
+      // The nearest of the least-covered bins: the pattern walks bin by bin
+      // instead of crossing the circle (the forcers turn it slowly). Once
+      // started, the move holds its target until a window opens (the
+      // pattern's own motion must not make the base look turning).
+      const uint32_t least = counts_[least_covered_bin()];
+      double best_dist = 1e300;
+      for (uint32_t b = 0; b < cfg_.bins; ++b) {
+        if (counts_[b] != least) continue;
+        const double target = bin_centre_near(b, theta_rad);
+        if (std::fabs(target - theta_rad) < best_dist) {
+          best_dist = std::fabs(target - theta_rad);
+          move_target_rad_ = target;
+        }
+      }
+      moving_ = true;
+    }
+  }
+  if (moving_) {
     d.pattern_command = true;
-    d.pattern_target_rad = bin_centre_near(least_covered_bin(), theta_rad);
+    d.pattern_target_rad = move_target_rad_;
   }
   return d;
 }

@@ -3,6 +3,7 @@
 // scenario (ring-up from rest, rate-table sweep, 8 parked angles).
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "sim_tools/job.hpp"
 #include "sim_tools/report.hpp"
@@ -147,4 +148,84 @@ TEST(EndToEnd, TheExecutiveRanEveryFrameWithoutMisses) {
   LONGS_EQUAL(0, r.frames.deadline_misses);
   CHECK(r.can_frames > 0);
   CHECK(r.failures.empty());
+}
+
+namespace {
+const JobConfig& static_job() {
+  static const JobConfig j = hrg::simtools::static_base_job(0.0);
+  return j;
+}
+const JobResult& static_result() {
+  static const JobResult r = [] {
+    JobResult x = hrg::simtools::run_job(static_job(), {});
+    hrg::simtools::judge(static_job(), x);
+    return x;
+  }();
+  return r;
+}
+}  // namespace
+
+TEST_GROUP(StaticBase){void setup()
+                           override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+(void)static_result();
+MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
+}
+}
+;
+
+TEST(StaticBase, TheFirmwareTurnsThePatternOnPurposeUntilEveryBinHasAWindow) {
+  // GIVEN a still table: only the Earth rate turns the pattern, by
+  // K/2 * 12.4 deg/h = 3.4 deg/h, far too slowly to cover the 4 theta circle
+  const auto& r = static_result();
+  double th_min = 1e9, th_max = -1e9;
+  std::size_t moving_rows = 0, moving_valid = 0;
+  for (const auto& row : r.rows) {
+    if (row.t_s < r.t_operate_s) continue;
+    th_min = std::fmin(th_min, row.theta_deg);
+    th_max = std::fmax(th_max, row.theta_deg);
+    moving_rows += row.pattern_cmd ? 1 : 0;
+    moving_valid += row.pattern_cmd && row.out_valid ? 1 : 0;
+  }
+  // THEN the pattern was moved over most of a 4 theta turn (90 deg of theta):
+  // 16 bins of 5.625 deg, each entered at least at its edge, span at least
+  // 14 bins (78.75 deg)
+  CHECK(th_max - th_min > 14 * 90.0 / 16);
+  CHECK(moving_rows > 0);
+  LONGS_EQUAL(0, moving_valid);  // the output is held while the pattern is moved
+  CHECK(r.campaign_done);
+  CHECK(r.windows >= 16);
+  DOUBLES_EQUAL(1.0, r.coverage, 0.0);
+}
+
+TEST(StaticBase, IdentificationAndTheRawErrorAgreeWithTheModel) {
+  const auto& r = static_result();
+  CHECK(r.identification.valid);
+  for (int i = 0; i < 5; ++i) {
+    CHECK(std::fabs(r.identification.p[i] - r.truth[static_cast<std::size_t>(i)]) <
+          5 * r.identification.sigma[i]);
+  }
+  // Over the valid output the raw error is -integral(D/K) of the true drift.
+  CHECK(std::fabs(r.raw_error_end_deg - r.model_error_end_deg) < 0.05 * r.drift_bound_deg + 0.02);
+}
+
+TEST(StaticBase, AfterTheCampaignTheCompensatedOutputHoldsStill) {
+  // On the parked pattern at the end, the raw output runs away at -D/K and
+  // the compensated one stays within a few deg/h.
+  const auto& r = static_result();
+  std::vector<double> t, raw, comp;
+  double model = 0;
+  for (const auto& row : r.rows) {
+    if (row.t_s < static_job().duration_s - 40.0 || !row.out_valid) continue;
+    t.push_back(row.t_s);
+    raw.push_back(row.raw_error_deg);
+    comp.push_back(row.out_error_deg);
+    model -= row.drift_true_dph;
+  }
+  CHECK(t.size() > 1000);
+  model /= static_cast<double>(t.size());
+  const double raw_dph = hrg::simtools::slope(t, raw) * 3600.0;
+  const double comp_dph = hrg::simtools::slope(t, comp) * 3600.0;
+  CHECK(std::fabs(model) > 10.0);  // the parked angle has a large drift
+  DOUBLES_EQUAL(model, raw_dph, 0.05 * std::fabs(model) + 0.5);
+  CHECK(std::fabs(comp_dph) < 2.0);
 }

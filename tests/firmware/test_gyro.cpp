@@ -236,7 +236,10 @@ TEST(Gyro, APatternCommandMovesThePatternWithTheOutputHeld) {
   chain.theta_rate_rad_per_block = -1e-5;
   run(g, 100);
   CHECK(g.status().out_valid);
-  DOUBLES_EQUAL(a0 + 2e-3 / 0.5, g.status().out_angle_rad, 1e-4);
+  // The output stays held for kPatternHoldFrames after the move, then follows:
+  // 80 frames of -1e-5 rad of theta, i.e. +2 * 8e-4 / K
+  DOUBLES_EQUAL(a0 + 2.0 * (100 - Gyro::kPatternHoldFrames) * 1e-5 / 0.5, g.status().out_angle_rad,
+                1e-9);
 }
 
 TEST(Gyro, ABoardWithAnotherBlockLayoutIsRefusedWithDrivesOff) {

@@ -114,8 +114,9 @@ TEST(ShutdownScheduler, OnAStaticBaseItCommandsThePatternToTheLeastCoveredBin) {
   for (int f = 0; f < 60; ++f)
     d = l.frame(0.01, 0.0);
   CHECK(d.pattern_command);
-  // bin 1 is the first least-covered one: centre at 4 theta = 67.5 deg
-  DOUBLES_EQUAL(3.0 * kPi / 32, d.pattern_target_rad, 1e-12);
+  // bin 7 (4 theta = 337.5 deg, theta = -5.6 deg) is the nearest empty bin to
+  // theta = 0.6 deg; bin 1 (theta = 16.9 deg) is farther
+  DOUBLES_EQUAL(-kPi / 32, d.pattern_target_rad, 1e-12);
   // WHEN the pattern gets there a window opens
   d = l.frame(d.pattern_target_rad, 0.0);
   CHECK(d.open);
@@ -180,4 +181,23 @@ TEST(ShutdownScheduler, TheEstimatorsWordCountsOnlyOnceEveryBinHasItsMinimum) {
   for (uint32_t b = 0; b < 8; ++b)
     CHECK(l.s.bin_count(b) >= 1);
   LONGS_EQUAL(8, l.s.windows());
+}
+
+TEST(ShutdownScheduler, OnAStaticBaseThePatternWalksToTheNearestEmptyBin) {
+  Loop l(small_config());  // 8 bins of 11.25 deg of theta
+  // GIVEN windows taken in bins 0 and 1 (theta 0.01 and 0.25)
+  for (int f = 0; f < 11; ++f)
+    l.frame(0.01, 0.0);
+  for (int f = 0; f < 60; ++f)
+    l.frame(0.25, 0.0);
+  LONGS_EQUAL(1, l.s.bin_count(0));
+  LONGS_EQUAL(1, l.s.bin_count(1));
+  // WHEN the pattern sits in bin 1 again after the period
+  WindowDecision d;
+  for (int f = 0; f < 60; ++f)
+    d = l.frame(0.25, 0.0);
+  // THEN it is sent to bin 2 (next to it), not back across the circle to bin 7
+  CHECK(d.pattern_command);
+  LONGS_EQUAL(2, l.s.bin_of(d.pattern_target_rad));
+  DOUBLES_EQUAL(2.5 * kPi / 16, d.pattern_target_rad, 1e-12);
 }

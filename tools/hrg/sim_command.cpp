@@ -22,7 +22,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
-    "               [--bias-angles N] [--real-time] [--no-plots] [--quiet]\n\n"
+    "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
+    "               [--quiet]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -30,6 +31,8 @@ constexpr const char* kUsage =
     "5e-4 Hz), Earth rate at 55.75 deg N, ring-up from rest, a rate-table sweep\n"
     "and an IEEE 1431 style parked-angle bias test (about 250 simulated s).\n"
     "--duration lengthens the parks (or shortens the run, dropping parks).\n"
+    "--static-base: no rate table; the firmware turns the pattern on purpose\n"
+    "(pattern-angle command) to fill the 4 theta bins between windows.\n"
     "--real-time paces the same executive by CLOCK_MONOTONIC (1 ms frames,\n"
     "SCHED_FIFO and mlockall when permitted) and counts deadline misses.\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
@@ -52,7 +55,7 @@ int sim_main(std::span<char* const> args) {
   std::string scenario, out_dir = "sim-out", can_log;
   double duration_s = 0.0;
   int bias_angles = 16;
-  bool plots = true, quiet = false, real_time = false;
+  bool plots = true, quiet = false, real_time = false, static_base = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
     const auto value = [&](const char* what) -> const char* {
@@ -93,6 +96,8 @@ int sim_main(std::span<char* const> args) {
         return 2;
       }
       bias_angles = static_cast<int>(n);
+    } else if (a == "--static-base") {
+      static_base = true;
     } else if (a == "--real-time") {
       real_time = true;
     } else if (a == "--no-plots") {
@@ -107,8 +112,13 @@ int sim_main(std::span<char* const> args) {
 
   simtools::JobConfig job;
   try {
-    job = scenario.empty() ? simtools::default_job(duration_s, bias_angles)
-                           : simtools::job_from_scenario(scenario, duration_s, bias_angles);
+    if (!scenario.empty()) {
+      job = simtools::job_from_scenario(scenario, duration_s, bias_angles);
+    } else if (static_base) {
+      job = simtools::static_base_job(duration_s);
+    } else {
+      job = simtools::default_job(duration_s, bias_angles);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;

@@ -50,8 +50,11 @@ def main(out):
     fig, ax = plt.subplots(figsize=(10, 4.5))
     shade_windows(ax, t, tel["exc"])
     tv = [ti for ti, v in zip(t, valid) if v]
-    raw = [a - b for a, b, v in zip(tel["raw_angle_deg"], tel["true_angle_deg"], valid) if v]
-    comp = [a - b for a, b, v in zip(tel["out_angle_deg"], tel["true_angle_deg"], valid) if v]
+    # Errors accumulated over the valid output only (hrg sim's raw_error_deg
+    # and out_error_deg): a held output while the pattern is moved on purpose
+    # is not an error.
+    raw = [e for e, v in zip(tel["raw_error_deg"], valid) if v]
+    comp = [e for e, v in zip(tel["out_error_deg"], valid) if v]
     model, acc = [], 0.0
     for d, v in zip(tel["drift_true_dph"], valid):
         if v:
@@ -72,9 +75,9 @@ def main(out):
     # 2. Bias against pattern angle, raw and compensated, with the fits.
     bias_path = os.path.join(out, "bias.csv")
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    if os.path.exists(bias_path) and os.path.getsize(bias_path) > 40:
-        b = read_csv(bias_path)
-        th = b.get("theta_deg", [])
+    b = read_csv(bias_path) if os.path.exists(bias_path) else {}
+    if b.get("theta_deg"):
+        th = b["theta_deg"]
         ax.plot(th, b["raw_dph"], "o", label="raw")
         ax.plot(th, b["compensated_dph"], "s", label="compensated")
         ax.plot(th, b["model_dph"], "x", label="drift model (truth)")
@@ -116,10 +119,9 @@ def main(out):
     # 4. Allan deviation of the compensated output rate error.
     fig, ax = plt.subplots(figsize=(7, 4.5))
     allan_path = os.path.join(out, "allan.csv")
-    if os.path.exists(allan_path) and os.path.getsize(allan_path) > 20:
-        a = read_csv(allan_path)
-        if a.get("tau_s"):
-            ax.loglog(a["tau_s"], a["adev_dph"], "o-")
+    a = read_csv(allan_path) if os.path.exists(allan_path) else {}
+    if a.get("tau_s"):
+        ax.loglog(a["tau_s"], a["adev_dph"], "o-")
     ax.set_xlabel("tau (s)")
     ax.set_ylabel("Allan deviation (deg/h)")
     ax.set_title("Allan deviation of the output rate (compensated, truth removed)")

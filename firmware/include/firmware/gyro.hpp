@@ -58,6 +58,9 @@ struct GyroStatus {
 class Gyro {
  public:
   static constexpr std::size_t kTaskCount = 6;
+  // Frames the output stays held after a commanded pattern move (longer than
+  // the DAC and demodulator latency, a few frames).
+  static constexpr uint32_t kPatternHoldFrames = 20;
 
   // `timer` measures task execution time (the board clock in real time, a
   // host clock in lockstep).
@@ -124,6 +127,7 @@ class Gyro {
   uint32_t progress_frames_ = 0;  // frames the current mode's exit condition has held
   bool adc_stuck_ = false;
   bool dac_error_ = false;
+  uint32_t pattern_hold_frames_ = 0;
   bool host_pattern_ = false;
   bool compensation_ready_ = false;
   double host_pattern_target_rad_ = 0.0;

@@ -81,6 +81,8 @@ class ShutdownScheduler {
   uint32_t windows_ = 0;
   bool in_window_ = false;
   bool done_ = false;
+  bool moving_ = false;  // a commanded pattern move is under way
+  double move_target_rad_ = 0.0;
 };
 
 }  // namespace hrg::fw

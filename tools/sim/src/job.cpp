@@ -133,6 +133,24 @@ JobConfig default_job(double duration_s, int bias_angles) {
   return j;
 }
 
+JobConfig static_base_job(double duration_s) {
+  JobConfig j = default_job(60.0, 4);
+  j.description =
+      "seed resonator on a static base (Earth rate at 55.75 deg N only); the firmware turns "
+      "the pattern on purpose to fill the 4 theta bins";
+  j.sim.rate_rad_s = sim::Profile::constant(j.earth_rate_rad_s);
+  j.parks.clear();
+  j.duration_s = duration_s > 0 ? duration_s : 300.0;
+  j.sweep_end_s = j.duration_s;
+  fw::WindowConfig& w = j.gyro.windows;
+  w.rotate_on_static_base = true;
+  w.min_windows_per_bin = 1;
+  w.windows_per_bin = 2;
+  w.period_frames = 1500;
+  derive_firmware_config(j);
+  return j;
+}
+
 void derive_firmware_config(JobConfig& j) {
   dsp::ChainConfig& c = j.chain;
   c.sample_rate_hz = j.sim.adc.sample_rate_hz;
@@ -175,6 +193,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim
   row.drift_true_dph = true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) /
                        job.gyro.angular_gain * kRadSToDph;
   row.out_valid = st.out_valid ? 1 : 0;
+  row.pattern_cmd = st.pattern_control ? 1 : 0;
   r.rows.push_back(row);
 }
 
@@ -199,31 +218,36 @@ void summarise_executive(JobResult& r, const fw::Gyro& g) {
 }
 
 void analyse(JobResult& r, const JobConfig& job) {
-  // Tracking: compensated output against the truth while the output is valid.
+  // Errors against the truth over the valid output, and the drift model's
+  // prediction for the raw error: it falls behind the truth at D/K
+  // (Omega K = -2 theta' + D).
   double sum2 = 0;
   std::size_t n = 0;
   const double dt_h = 1.0 / job.telemetry_hz / 3600.0;
-  double model_deg = 0, bound_deg = 0;
-  for (const Row& row : r.rows) {
+  double model_deg = 0, bound_deg = 0, raw_err = 0, out_err = 0;
+  const Row* prev = nullptr;
+  for (Row& row : r.rows) {
+    if (row.out_valid && prev != nullptr && prev->out_valid) {
+      const double d_true = row.true_angle_deg - prev->true_angle_deg;
+      raw_err += row.raw_angle_deg - prev->raw_angle_deg - d_true;
+      out_err += row.out_angle_deg - prev->out_angle_deg - d_true;
+    }
+    row.raw_error_deg = raw_err;
+    row.out_error_deg = out_err;
+    prev = &row;
     if (!row.out_valid) continue;
-    // What the drift model predicts for the raw output: it falls behind the
-    // truth at D/K (Omega K = -2 theta' + D).
     model_deg -= row.drift_true_dph * dt_h;
     bound_deg += std::fabs(row.drift_true_dph) * dt_h;
     if (row.t_s < r.t_operate_s) continue;
-    const double e = row.out_angle_deg - row.true_angle_deg;
-    sum2 += e * e;
+    sum2 += out_err * out_err;
     ++n;
-    r.tracking_max_deg = std::max(r.tracking_max_deg, std::fabs(e));
+    r.tracking_max_deg = std::max(r.tracking_max_deg, std::fabs(out_err));
   }
   r.tracking_rms_deg = n ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
   r.model_error_end_deg = model_deg;
   r.drift_bound_deg = bound_deg;
-  if (!r.rows.empty()) {
-    const Row& last = r.rows.back();
-    r.raw_error_end_deg = last.raw_angle_deg - last.true_angle_deg;
-    r.comp_error_end_deg = last.out_angle_deg - last.true_angle_deg;
-  }
+  r.raw_error_end_deg = raw_err;
+  r.comp_error_end_deg = out_err;
 
   // Parked bias: slope of the angle error over each park, in deg/h.
   std::vector<double> th, braw, bcomp, bmodel;

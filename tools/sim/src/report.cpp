@@ -184,7 +184,10 @@ void write_telemetry(const std::filesystem::path& path, const JobConfig& job, co
                                 "a_b_v",
                                 "drift_model_dph",
                                 "drift_true_dph",
-                                "out_valid"};
+                                "out_valid",
+                                "pattern_cmd",
+                                "raw_error_deg",
+                                "out_error_deg"};
   recording::RecordingWriter wr(path, cols, job.chain.f_center_hz, job.gyro.angular_gain,
                                 {{"source", "hrg sim (firmware + sim_target in lockstep)"},
                                  {"scenario", job.description},
@@ -212,7 +215,10 @@ void write_telemetry(const std::filesystem::path& path, const JobConfig& job, co
          row.a_b_v,
          row.drift_model_dph,
          row.drift_true_dph,
-         double(row.out_valid)};
+         double(row.out_valid),
+         double(row.pattern_cmd),
+         row.raw_error_deg,
+         row.out_error_deg};
     wr.write_row(v);
   }
   wr.close();

@@ -45,6 +45,12 @@ struct JobConfig {
 // lengthens the parks; a shorter one drops the parks that do not fit.
 JobConfig default_job(double duration_s, int bias_angles = 16);
 
+// The static-base variant: the same resonator on a still table (Earth rate
+// only). The firmware fills the 4 theta bins by turning the pattern on
+// purpose (pattern-angle command through the forcers) between windows; the
+// output is held while the pattern is moved. Default length 300 s.
+JobConfig static_base_job(double duration_s);
+
 // Fills the firmware-side configuration (chain converters, estimator K) from
 // the simulated board, so that a scenario only has to describe the target.
 void derive_firmware_config(JobConfig& job);
@@ -58,6 +64,11 @@ struct Row {
   double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
   double a_a_v, a_b_v, drift_model_dph, drift_true_dph;
   int out_valid;
+  int pattern_cmd;  // the pattern is being moved on purpose
+  // Output minus truth, accumulated only between consecutive rows with a
+  // valid output (a held output while the pattern is moved on purpose does
+  // not count as an error), deg.
+  double raw_error_deg, out_error_deg;
 };
 
 struct ParkResult {
