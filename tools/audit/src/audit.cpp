@@ -8,6 +8,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <Eigen/Dense>
+
 #include "audit/plots.hpp"
 #include "dataset.hpp"
 #include "dsp/wave_variables.hpp"
@@ -251,21 +253,30 @@ AuditResult Auditor::run(PlotData* plot) {
   State cur = fit_state(base, p0, false);
   if (d_.forced.size() >= 3) {
     // Weight of each excitation segment: its white-noise error and the
-    // scatter the baseline leaves beyond it (robust, about the median so that
-    // a common offset, the spring's signature, does not count as scatter).
+    // scatter the baseline leaves beyond it. The scatter is measured after
+    // taking out what the frequency-shifting candidates could explain (pump
+    // voltage squared, amplitude squared, temperature), so that the signature
+    // of an effect is not counted as noise; with few segments only the pump
+    // term is taken out.
     const auto fr = forced_residuals(d_, cur.fit.p);
-    std::vector<double> dev(fr), se2;
-    auto median = [](std::vector<double> v) {
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-      return v[v.size() / 2];
-    };
-    const double med = median(dev);
-    for (auto& v : dev)
-      v = std::abs(v - med);
-    for (const auto& f : d_.forced)
-      se2.push_back(f.se_rad_s * f.se_rad_s);
-    const double mad = 1.4826 * median(dev);
-    const double extra2 = std::max(0.0, mad * mad - median(se2));
+    const std::size_t n = fr.size();
+    const int p = n >= 8 ? 3 : 1;
+    Eigen::MatrixXd h(static_cast<Eigen::Index>(n), p);
+    Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+    double se2 = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& f = d_.forced[i];
+      const auto r = static_cast<Eigen::Index>(i);
+      h(r, 0) = f.mean_v2;
+      if (p == 3) h(r, 1) = f.mean_a2, h(r, 2) = f.mean_temp_c - d_.temp_ref_c;
+      y(r) = fr[i];
+      se2 += f.se_rad_s * f.se_rad_s / static_cast<double>(n);
+    }
+    const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+    const double rss = (y - h * coef).squaredNorm();
+    const double extra2 = std::max(
+        0.0,
+        rss / static_cast<double>(std::max<std::size_t>(1, n - static_cast<std::size_t>(p))) - se2);
     for (auto& f : d_.forced)
       f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
     eo_.use_forced = true;
@@ -293,7 +304,7 @@ AuditResult Auditor::run(PlotData* plot) {
 
   // Forward selection.
   std::vector<Effect> chosen;
-  std::vector<double> chosen_dbic;
+  std::vector<double> chosen_dbic, chosen_dchi;
   FeedStat ft;
   bool first_step = true;
   while (chosen.size() < 4) {
@@ -371,6 +382,7 @@ AuditResult Auditor::run(PlotData* plot) {
     }
     chosen.push_back(win.e);
     chosen_dbic.push_back(win.dbic);
+    chosen_dchi.push_back(cur.fit.chi2 - win.s.fit.chi2);
     cur = win.s;
   }
 
@@ -381,6 +393,7 @@ AuditResult Auditor::run(PlotData* plot) {
     if (dbic >= opt_.min_delta_bic) {
       chosen.push_back(Effect::drive_feedthrough);
       chosen_dbic.push_back(dbic);
+      chosen_dchi.push_back(ft.dchi2);
     } else if (dbic > 0.0) {
       out.alternatives.push_back({Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic,
                                   "some evidence, below the acceptance level"});
@@ -409,7 +422,23 @@ AuditResult Auditor::run(PlotData* plot) {
   out.fit_rms_after_v = rms_v(cur);
   out.heldout_rms_v = heldout_rms(baseline.mask, baseline.fit.p);
   out.heldout_rms_final_v = chosen.empty() ? out.heldout_rms_v : heldout_rms(cur.mask, cur.fit.p);
+  // With structure left that no candidate takes up, a candidate that only
+  // nibbles at it is not a finding: only effects that explain a real share of
+  // the baseline's misfit are claimed, the rest are listed as alternatives.
+  const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  const bool structure_left = ratio > opt_.unexplained_ratio;
+  const double excess0 = baseline.fit.chi2 - static_cast<double>(baseline.fit.n_res);
   for (std::size_t i = 0; i < chosen.size(); ++i) {
+    if (structure_left &&
+        (chosen[i] == Effect::drive_feedthrough || chosen_dchi[i] < 0.2 * std::max(excess0, 1.0))) {
+      const auto pi = param_of(chosen[i]);
+      const double v = pi < 0 ? std::max(ft.c_x, ft.c_y)
+                              : to_catalogue(chosen[i], cur.fit.p[static_cast<std::size_t>(pi)]);
+      out.alternatives.push_back({chosen[i], v, chosen_dbic[i],
+                                  "takes up only part of structure that stays unexplained; "
+                                  "not claimed"});
+      continue;
+    }
     Finding f;
     f.effect = chosen[i];
     f.delta_bic = chosen_dbic[i];
@@ -429,9 +458,10 @@ AuditResult Auditor::run(PlotData* plot) {
   }
   out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.use_forced, ft);
 
+  std::sort(out.findings.begin(), out.findings.end(),
+            [](const Finding& a, const Finding& b) { return a.delta_bic > b.delta_bic; });
   // Structure left after the selected model.
-  const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
-  if (ratio > opt_.unexplained_ratio) {
+  if (structure_left) {
     const auto left = locate(d_, cur.fit.p, cur.res, eo_.use_forced,
                              feedthrough_stat(d_, cur.fit.p, ln_neff(cur)));
     char buf[200];

@@ -95,9 +95,11 @@ std::string to_text(const AuditResult& r, const std::string& source) {
   std::string t;
   char buf[512];
   t += "VERDICT: " + r.verdict + "   (" + source + ")\n";
-  if (r.findings.empty()) {
+  if (r.findings.empty() && r.verdict == "consistent") {
     t += "  The seed's model explains the recording to the noise level; no left-out physics is "
          "justified.\n";
+  } else if (r.findings.empty()) {
+    t += "  No effect of the catalogue explains the misfit.\n";
   }
   for (const auto& f : r.findings) {
     const auto& info = effect_info(f.effect);
