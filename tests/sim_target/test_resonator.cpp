@@ -111,7 +111,7 @@ TEST(Resonator, TheTwoModesRingAtMeanPlusAndMinusHalfSplit) {
   DOUBLES_EQUAL(-0.5 * p.split_hz, fy, 1e-3 * p.split_hz);
 }
 
-TEST(Resonator, AgreesWithTheAveragedModelOverTwentySecondsWithRotation) {
+TEST(Resonator, AgreesWithTheAveragedModelOverTenSecondsWithRotation) {
   ResonatorParams p;
   p.th_mu_rad = 0.2;
   p.th_w_rad = 0.5;
@@ -122,8 +122,8 @@ TEST(Resonator, AgreesWithTheAveragedModelOverTwentySecondsWithRotation) {
   m.set_rate_profile(Profile::constant(rate));
   r.set_standing_wave(1.0, 0.3);
   m.set_standing_wave(1.0, 0.3);
-  ring(r, 20.0);
-  m.advance(20.0);
+  ring(r, 10.0);
+  m.advance(10.0);
   const WaveState wr = true_wave(r);
   const WaveState wa = m.wave();
   DOUBLES_EQUAL(0.0, std::remainder(wr.theta_rad - wa.theta_rad, kPi / 2), 1e-5);
@@ -142,7 +142,7 @@ TEST(Resonator, AgreesWithTheAveragedModelUnderASineRateAndATemperatureRamp) {
   fx.thermal_damping.enabled = true;
   fx.thermal_damping.rel_per_c = 0.01;
   const Profile rate = Profile::sine(200.0 * kDegToRad, 2.0, 0.3);
-  const Profile temp = Profile::ramps({{0.0, 25.0}, {3.0, 35.0}});
+  const Profile temp = Profile::ramps({{0.0, 25.0}, {1.5, 35.0}});
   Resonator r(p, {}, fx);
   AveragedModel m(p, {}, fx);
   r.set_rate_profile(rate);
@@ -152,15 +152,27 @@ TEST(Resonator, AgreesWithTheAveragedModelUnderASineRateAndATemperatureRamp) {
   m.set_max_step_s(1e-3);
   r.set_standing_wave(1.0, 0.3);
   m.set_standing_wave(1.0, 0.3);
-  // WHEN both run 3 s
-  ring(r, 3.0);
-  m.advance(3.0);
-  // THEN angle, amplitude and the accumulated phase (-50 ppm/degC over the ramp: -23.6 rad
-  // relative to the nominal carrier) agree
-  const WaveState wr = true_wave(r);
+  // WHEN both run 1.5 s
+  ring(r, 1.5);
+  // The instantaneous x - i x'/w differs from the envelope by O(Omega K / w) at 2w
+  // (a few 1e-6 rad here): average the full-rate angle over one carrier period
+  // (samples 1..20 after 1.5 s, mean time 1.5 s + 10.5 h).
+  double theta_sum = 0.0;
+  double last = true_wave(r).theta_rad;
+  double theta_unwrapped = last;
+  for (int n = 0; n < 20; ++n) {
+    r.step({}, kDt);
+    const double now = true_wave(r).theta_rad;
+    theta_unwrapped += std::remainder(now - last, kPi / 2);
+    last = now;
+    theta_sum += theta_unwrapped;
+  }
+  m.advance(1.5 + 10.5 * kDt);
   const WaveState wa = m.wave();
-  DOUBLES_EQUAL(0.0, std::remainder(wr.theta_rad - wa.theta_rad, kPi / 2), 2e-6);
-  DOUBLES_EQUAL(wa.a_a_v, wr.a_a_v, 1e-6);
+  DOUBLES_EQUAL(0.0, std::remainder(theta_sum / 20.0 - wa.theta_rad, kPi / 2), 2e-7);
+  m.advance(9.5 * kDt);  // now at the same time as the full-rate model
+  const WaveState wr = true_wave(r);
+  DOUBLES_EQUAL(m.wave().a_a_v, wr.a_a_v, 1e-6);
   const double w0 = p.omega_rad_s();
   cplx x;
   cplx y;
@@ -168,5 +180,5 @@ TEST(Resonator, AgreesWithTheAveragedModelUnderASineRateAndATemperatureRamp) {
   const double phase_full =
       std::arg((x * std::cos(2 * wr.theta_rad) + y * std::sin(2 * wr.theta_rad)) *
                std::polar(1.0, -w0 * r.time_s()));
-  DOUBLES_EQUAL(0.0, std::remainder(phase_full - wa.phase_a_rad, 2 * kPi), 1e-5);
+  DOUBLES_EQUAL(0.0, std::remainder(phase_full - m.wave().phase_a_rad, 2 * kPi), 1e-5);
 }
