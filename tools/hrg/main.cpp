@@ -14,7 +14,7 @@ void print_help(std::FILE* out) {
                "Hemispherical resonator gyro (whole-angle mode): simulation, telemetry\n"
                "and audit tools.\n\ncommands:\n");
   for (const auto& c : hrg::cli::commands()) {
-    std::fprintf(out, "  %-12.*s %.*s\n", static_cast<int>(c.name.size()), c.name.data(),
+    std::fprintf(out, "  %-15.*s %.*s\n", static_cast<int>(c.name.size()), c.name.data(),
                  static_cast<int>(c.summary.size()), c.summary.data());
   }
   std::fprintf(out, "\n'hrg <command> --help' describes a command's options.\n");
