@@ -19,7 +19,8 @@ constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
 
 // One run shared by the tests of the group (it takes a few seconds).
 const JobConfig& job() {
-  static const JobConfig j = hrg::simtools::default_job(0.0, 8);
+  // 200 s: ring-up, sweep and 8 parks, without the default run's final still hold.
+  static const JobConfig j = hrg::simtools::default_job(200.0, 8);
   return j;
 }
 const JobResult& result() {

@@ -95,11 +95,14 @@ JobConfig default_job(double duration_s, int bias_angles) {
   const double step_case_rad = (kPi / 2.0) / bias_angles * 2.0 / k;
   const double slew_rate = 20.0 * kDeg;
   const double step_s = std::fabs(step_case_rad) / slew_rate + 0.5;
+  // After the parks the table stays still for a while: the longest still
+  // record, for the Allan deviation (dropped first when the run is shortened).
+  const double final_hold_s = 100.0;
   double hold_s = base_hold_s;
   const double t_bias0 = sch.t;
-  const double min_total = t_bias0 + bias_angles * (step_s + settle_s + base_hold_s);
-  if (duration_s > min_total) {
-    hold_s = (duration_s - t_bias0) / bias_angles - step_s - settle_s;
+  const double parks_s = bias_angles * (step_s + settle_s + base_hold_s);
+  if (duration_s > t_bias0 + parks_s + final_hold_s) {
+    hold_s = (duration_s - final_hold_s - t_bias0) / bias_angles - step_s - settle_s;
   }
   for (int i = 0; i < bias_angles; ++i) {
     if (duration_s > 0 && sch.t + step_s + settle_s + hold_s > duration_s) break;
@@ -109,6 +112,7 @@ JobConfig default_job(double duration_s, int bias_angles) {
     sch.hold(hold_s);
     j.parks.push_back({t0, sch.t});
   }
+  if (duration_s <= 0) sch.hold(final_hold_s);
   j.duration_s = duration_s > 0 ? duration_s : sch.t;
   s.rate_rad_s = sim::Profile::ramps(sch.pts).add_offset(j.earth_rate_rad_s);
 
@@ -282,16 +286,27 @@ void analyse(JobResult& r, const JobConfig& job) {
   r.fit_comp = fit_bias_4theta(th, bcomp);
   r.fit_model = fit_bias_4theta(th, bmodel);
 
-  // Allan deviation of the compensated output rate over the longest stretch
-  // of valid output without a commanded move (from the last invalid row on).
-  std::size_t first = 0;
-  for (std::size_t i = 0; i < r.rows.size(); ++i) {
-    if (!r.rows[i].out_valid) first = i + 1;
+  // Allan deviation of the compensated output rate (truth removed) over the
+  // longest stretch with a valid output on a still table (no rate-table
+  // motion, no commanded pattern move).
+  const double earth_dps = job.earth_rate_rad_s * 180.0 / 3.14159265358979323846;
+  std::size_t best_begin = 0, best_len = 0, begin = 0;
+  for (std::size_t i = 0; i <= r.rows.size(); ++i) {
+    const bool still = i < r.rows.size() && r.rows[i].out_valid && !r.rows[i].pattern_cmd &&
+                       r.rows[i].t_s >= r.t_operate_s &&
+                       std::fabs(r.rows[i].rate_dps - earth_dps) < 1e-6;
+    if (still) continue;
+    if (i - begin > best_len) {
+      best_len = i - begin;
+      best_begin = begin;
+    }
+    begin = i + 1;
   }
   std::vector<double> angle;
-  for (std::size_t i = first; i < r.rows.size(); ++i) {
-    angle.push_back((r.rows[i].out_angle_deg - r.rows[i].true_angle_deg) * kDeg);
+  for (std::size_t i = best_begin; i < best_begin + best_len; ++i) {
+    angle.push_back(r.rows[i].out_error_deg * kDeg);
   }
+  r.allan_span_s = static_cast<double>(best_len) / job.telemetry_hz;
   r.allan = allan_deviation(angle, 1.0 / job.telemetry_hz);
 }
 

@@ -147,6 +147,7 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.end_object();
   w.end_object();
 
+  w.number("allan_span_s", r.allan_span_s);
   w.begin_array("allan_deviation");
   for (const auto& p : r.allan) {
     w.begin_object();
@@ -290,11 +291,10 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
             fmt("%.1f us", t.max_ns / 1e3), fmt("%.2f us", t.mean_ns / 1e3), fmt("%u", t.overruns),
             fmt("%u", t.slips)});
   }
-  ex.row({"frames", fmt("%llu", static_cast<unsigned long long>(r.frames.frames)),
-          fmt("missed %u", r.frames.missed_frames),
-          fmt("deadline misses %u", r.frames.deadline_misses),
-          fmt("max frame %.1f us", r.frames.max_frame_ns / 1e3)});
   ex.print(out);
+  std::fprintf(out, "  frames %llu, missed %u, deadline misses %u, max frame %.1f us\n",
+               static_cast<unsigned long long>(r.frames.frames), r.frames.missed_frames,
+               r.frames.deadline_misses, r.frames.max_frame_ns / 1e3);
   if (r.failures.empty()) {
     std::fprintf(out, "result: PASS\n");
   } else {

@@ -113,6 +113,7 @@ struct JobResult {
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
   std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
+  double allan_span_s = 0.0;      // length of the still stretch it was computed on
   double tracking_rms_deg = 0.0;  // compensated output - true, after operate
   double tracking_max_deg = 0.0;
   double raw_error_end_deg = 0.0;    // raw output - true at the end
