@@ -326,7 +326,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   // the simulated converters behind it.
   HostClock host_timer;
   hal::linux_board::LinuxClock rt_clock;
-  hal::Board& sim_board = target.board();
+  hal::Board& sim_board = hal::board();  // the simulated target, chosen at link time
   hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
                       sim_board.fault_input, sim_board.can, rt_clock};
   r.real_time = opt.real_time;
