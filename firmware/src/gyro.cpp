@@ -289,4 +289,63 @@ void Gyro::task_telemetry(Gyro& g) {
   }
 }
 
+void Gyro::task_commands(Gyro& g) {
+  can::ControllerView view;
+  view.mode = g.mode_.mode();
+  view.faults = static_cast<uint16_t>(g.status_.faults | g.mode_.faults());
+  view.fault_input = g.status_.fault_input;
+  view.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
+  view.agc_setpoint_v = g.cfg_.amplitude_set_v;
+  for (uint32_t n = 0; n < kCommandsPerRun; ++n) {
+    hal::CanFrame f;
+    if (g.board_.can.receive(f) != hal::Status::ok) break;
+    const can::CommandOutcome out = g.validator_.process(f, view);
+    if (!out.for_us) continue;
+    if (out.result == can::CommandResult::accepted) {
+      ++g.cmd_accepted_;
+      g.apply(out.command);
+    } else {
+      ++g.cmd_refused_;
+    }
+    if (g.board_.can.send(out.reply) != hal::Status::ok) ++g.can_refused_;
+    if (out.result == can::CommandResult::accepted && out.command.id == can::Cmd::status_request) {
+      hal::CanFrame status;
+      g.telemetry_.encode_now(can::Tm::status, g.snapshot_, status);
+      if (g.board_.can.send(status) != hal::Status::ok) ++g.can_refused_;
+    }
+    view.mode = g.mode_.mode();
+    view.agc_setpoint_v = g.cfg_.amplitude_set_v;
+  }
+}
+
+void Gyro::apply(const can::Command& c) {
+  switch (c.id) {
+    case can::Cmd::set_mode:
+      // The host may stop the drives (safe) or ask for a ring-up from safe
+      // (a restart through power_up) or from fault (a retry now); the
+      // validator refuses every other target.
+      if (c.mode == Mode::safe) {
+        mode_.handle(Event::command_safe);
+      } else if (c.mode == Mode::ring_up) {
+        mode_.handle(mode_.mode() == Mode::fault ? Event::fault_cleared : Event::command_restart);
+      }
+      break;
+    case can::Cmd::ident:
+      cfg_.identify = c.ident_start;
+      // A new campaign from scratch (no heap: the scheduler is rebuilt in place).
+      if (c.ident_start) scheduler_ = ShutdownScheduler(cfg_.windows);
+      break;
+    case can::Cmd::window:
+      cfg_.windows.period_frames = static_cast<uint32_t>(c.window_period_s * kBaseRateHz + 0.5);
+      cfg_.windows.length_frames = static_cast<uint32_t>(c.window_length_s * kBaseRateHz + 0.5);
+      scheduler_.set_timing(cfg_.windows.length_frames, cfg_.windows.period_frames);
+      break;
+    case can::Cmd::agc:
+      cfg_.amplitude_set_v = c.agc_setpoint_v;
+      monitor_.set_amplitude_set_v(c.agc_setpoint_v);
+      break;
+    case can::Cmd::status_request: break;
+  }
+}
+
 }  // namespace hrg::fw

@@ -50,6 +50,26 @@ TEST(FakeBoard, TheDacRemembersWhichChannelsWereDriven) {
   CHECK(Status::io_error == b.dac.write_block(block));
 }
 
+TEST(FakeBoard, TheCanBusHandsOutInjectedFramesInOrderAndFindsSentOnes) {
+  hrg::fakes::FakeBoard b;
+  hrg::hal::CanFrame f;
+  CHECK(Status::would_block == b.can.receive(f));
+  hrg::hal::CanFrame a, c;
+  a.id = 0x81;
+  c.id = 0x82;
+  CHECK(b.can.inject(a));
+  CHECK(b.can.inject(c));
+  CHECK(Status::ok == b.can.receive(f));
+  LONGS_EQUAL(0x81, f.id);
+  CHECK(Status::ok == b.can.receive(f));
+  LONGS_EQUAL(0x82, f.id);
+  CHECK(Status::would_block == b.can.receive(f));
+  b.can.send(a);
+  b.can.send(c);
+  CHECK(b.can.last_with_id(0x81, f));
+  CHECK_FALSE(b.can.last_with_id(0x99, f));
+}
+
 TEST_GROUP(FakeChain){};
 
 TEST(FakeChain, RingsUpToTheSetPointWhileDrivenAndDecaysWhenNot) {

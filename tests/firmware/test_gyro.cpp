@@ -262,3 +262,49 @@ TEST(Gyro, SendsTheCanTelemetryAtTheProtocolsDefaultRates) {
   LONGS_EQUAL(0, g.can_tx_refused());
   DOUBLES_EQUAL(cfg.angular_gain, g.telemetry().angular_gain, 0.0);
 }
+
+TEST(Gyro, ACanSetModeSafeCommandStopsTheDrivesAndIsAcknowledged) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::operate) > 0);
+  b.can.inject(hrg::fw::can::encode_set_mode(Mode::safe, 1));
+  CHECK(run_until(g, Mode::safe, 20) > 0);  // the command task runs at 100 Hz
+  LONGS_EQUAL(1, g.commands_accepted());
+  hrg::hal::CanFrame f;
+  CHECK(b.can.last_with_id(hrg::fw::can::kReplyId, f));
+  hrg::fw::can::Reply r;
+  CHECK(hrg::fw::can::decode_reply(f, r));
+  CHECK(hrg::fw::can::CommandResult::accepted == r.result);
+  LONGS_EQUAL(1, r.counter);
+  g.run_frame();
+  CHECK_FALSE(b.enable.level());
+  // AND a ring-up command brings it back through power-up
+  b.can.inject(hrg::fw::can::encode_set_mode(Mode::ring_up, 2));
+  CHECK(run_until(g, Mode::operate) > 0);
+}
+
+TEST(Gyro, ACorruptedCommandIsRefusedAndChangesNothing) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  CHECK(run_until(g, Mode::operate) > 0);
+  auto f = hrg::fw::can::encode_set_mode(Mode::safe, 1);
+  f.data[0] ^= 0x01;  // the CRC no longer matches
+  b.can.inject(f);
+  run(g, 20);
+  CHECK(Mode::safe != g.status().mode);
+  LONGS_EQUAL(0, g.commands_accepted());
+  LONGS_EQUAL(1, g.commands_refused());
+}
+
+TEST(Gyro, CanCommandsSetTheAgcSetPointAndTheWindowTiming) {
+  auto cfg = test_config();
+  cfg.identify = false;  // settings are refused during a free-decay window
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  b.can.inject(hrg::fw::can::encode_agc(1.1, 1));
+  b.can.inject(hrg::fw::can::encode_window(2.0, 0.25, 2));
+  run(g, 20);
+  LONGS_EQUAL(2, g.commands_accepted());
+  DOUBLES_EQUAL(1.1, g.config().amplitude_set_v, 1e-3);
+  DOUBLES_EQUAL(1.1, chain.last_commands().amplitude_set_v, 1e-3);
+  LONGS_EQUAL(2000, g.scheduler().config().period_frames);
+  LONGS_EQUAL(250, g.scheduler().config().length_frames);
+}

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "firmware/angle_output.hpp"
+#include "firmware/can/command.hpp"
 #include "firmware/can/telemetry.hpp"
 #include "firmware/executive.hpp"
 #include "firmware/fault_monitor.hpp"
@@ -57,7 +58,9 @@ struct GyroStatus {
 // scheduler and the angle output. Everything is allocated at construction.
 class Gyro {
  public:
-  static constexpr std::size_t kTaskCount = 6;
+  static constexpr std::size_t kTaskCount = 7;
+  // CAN command frames handled per command task run (the rest wait).
+  static constexpr uint32_t kCommandsPerRun = 4;
   // Frames the output stays held after a commanded pattern move (longer than
   // the DAC and demodulator latency, a few frames).
   static constexpr uint32_t kPatternHoldFrames = 20;
@@ -98,11 +101,17 @@ class Gyro {
   static void task_output(Gyro& g);
   static void task_solve(Gyro& g);
   static void task_telemetry(Gyro& g);
+  static void task_commands(Gyro& g);
+
+  // CAN commands: accepted, refused (any reason), last result.
+  uint32_t commands_accepted() const { return cmd_accepted_; }
+  uint32_t commands_refused() const { return cmd_refused_; }
 
  private:
   void on_mode_change(Mode from, Mode to);
   bool in_bands() const;
   void step_mode_progress(const WindowDecision& d);
+  void apply(const can::Command& c);
 
   hal::Board& board_;
   SignalChain& chain_;
@@ -118,6 +127,9 @@ class Gyro {
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
   uint32_t can_refused_ = 0;
+  can::CommandValidator validator_{};
+  uint32_t cmd_accepted_ = 0;
+  uint32_t cmd_refused_ = 0;
   ChainCommands commands_{};
   std::array<hal::sample_q31, kBlockFrames * hal::kAdcChannels> adc_{};
   std::array<hal::sample_q31, kBlockFrames * hal::kDacChannels> dac_{};
@@ -148,6 +160,7 @@ inline constexpr std::array<Task<Gyro>, Gyro::kTaskCount> kGyroTasks{{
     {"output", &Gyro::task_output, kBaseRateHz, 20'000},
     {"solve", &Gyro::task_solve, 10, 200'000},
     {"telemetry", &Gyro::task_telemetry, kBaseRateHz, 60'000},
+    {"commands", &Gyro::task_commands, 100, 30'000},
 }};
 static_assert(all_rates_divide(kGyroTasks, kBaseRateHz),
               "every task rate must divide the base rate");

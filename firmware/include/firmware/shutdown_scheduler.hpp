@@ -51,6 +51,13 @@ class ShutdownScheduler {
   WindowDecision step(Mode mode, double theta_rad, double theta_rate_rad_s,
                       const EstimatorHealth& health);
 
+  // New window length and period (a host command); coverage, duty and the
+  // campaign state are kept. Zero length is taken as one frame.
+  void set_timing(uint32_t length_frames, uint32_t period_frames) {
+    cfg_.length_frames = length_frames == 0 ? 1 : length_frames;
+    cfg_.period_frames = period_frames;
+  }
+
   // 4 theta bin index of a physical angle, 0..bins-1.
   uint32_t bin_of(double theta_rad) const;
   // theta_A nearest to `from_rad` whose 4 theta lies at the centre of `bin`.
