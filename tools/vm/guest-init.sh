@@ -28,6 +28,13 @@ check() {  # check NAME COMMAND...: runs, prints, remembers a failure
   if "$@"; then echo "guest: $name ok"; else echo "guest: $name FAILED"; failed=1; fi
 }
 
+# The host checks that a failing guest is seen as failing (run-vm.sh with
+# hrg.selfcheck=fail on the kernel command line).
+if grep -q "hrg.selfcheck=fail" /proc/cmdline; then
+  echo "guest: self-check, reporting FAIL on purpose"
+  report FAIL
+fi
+
 step "modules"
 for m in $(cat /modules/order); do
   insmod /modules/$m || { echo "guest: insmod $m failed"; report FAIL; }

@@ -15,6 +15,12 @@ mkdir -p "$vm"
 tools/vm/build-gpio-sim.sh "$vm"
 tools/vm/build-initramfs.sh "$vm/initramfs.cpio.gz" "$vm/gpio-sim.ko" \
   build/host/bin/test_hal_linux_kernel build/host/bin/can_rig build/host/bin/hrg-board
+# The report channel must tell a failing guest from a passing one.
+if tools/vm/run-vm.sh "$vm/initramfs.cpio.gz" "$vm/selfcheck.log" 60 hrg.selfcheck=fail; then
+  echo "kernel-vm: a guest reporting FAIL was taken as a pass" >&2
+  exit 1
+fi
+echo "kernel-vm: self-check ok (the FAIL above was requested: a failing guest is detected)"
 status=0
 tools/vm/run-vm.sh "$vm/initramfs.cpio.gz" "$vm/console.log" 150 || status=1
 # The guest's own lines (the kernel is quiet); the full console is in the log.
