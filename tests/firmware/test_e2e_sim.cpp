@@ -230,3 +230,56 @@ TEST(StaticBase, AfterTheCampaignTheCompensatedOutputHoldsStill) {
   DOUBLES_EQUAL(model, raw_dph, 0.05 * std::fabs(model) + 0.5);
   CHECK(std::fabs(comp_dph) < 2.0);
 }
+
+namespace {
+// A rung-up gyro (1 V wave at t = 0) on a still table for 30 s with one
+// injected fault from 10 s to 10.5 s.
+JobResult run_with_fault(hrg::simtools::FaultEvent::Kind kind) {
+  JobConfig j = hrg::simtools::static_base_job(30.0);
+  j.gyro.identify = false;
+  j.sim.initial.amplitude_v = 1.0;
+  j.faults = {{10.0, kind, 1, true}, {10.5, kind, 1, false}};
+  JobResult r = hrg::simtools::run_job(j, {});
+  return r;
+}
+}  // namespace
+
+TEST_GROUP(InjectedFaults){void setup()
+                               override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+}
+void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
+}
+;
+
+TEST(InjectedFaults, AStuckAdcChannelIsAFaultAndTheGyroRecoversAfterTheHoldTime) {
+  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::adc_stuck);
+  CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::adc_stuck));
+  // Detected after 10 stuck blocks (10 ms), no sooner than the injection.
+  CHECK(r.t_first_fault_s >= 10.0);
+  CHECK(r.t_first_fault_s < 10.0 + 0.012);
+  // Back to operate: the fault lasts 0.5 s, then 500 clean frames of hold, a
+  // ring-up (the wave decayed by nu * 1 s only), and 200 frames of lock.
+  CHECK(r.t_back_operate_s > 10.5 + 0.5);
+  CHECK(r.t_back_operate_s < 10.5 + 0.5 + 2.0);
+  CHECK(hrg::fw::Mode::operate == r.final_mode);
+  // No drive while in fault: the excitation flag is off on every fault row.
+  for (const auto& row : r.rows) {
+    if (row.mode == static_cast<int>(hrg::fw::Mode::fault)) LONGS_EQUAL(0, row.exc);
+  }
+}
+
+TEST(InjectedFaults, ASaturatedAdcChannelIsAFaultAndTheGyroRecovers) {
+  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::adc_saturated);
+  CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::adc_saturation));
+  CHECK(r.t_first_fault_s >= 10.0);
+  CHECK(r.t_first_fault_s < 10.0 + 0.007);  // 5 saturated blocks
+  CHECK(hrg::fw::Mode::operate == r.final_mode);
+}
+
+TEST(InjectedFaults, TheBoardFaultInputEndsInSafeWithTheDrivesOff) {
+  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::fault_input);
+  CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::external));
+  CHECK(hrg::fw::Mode::safe == r.final_mode);  // only a command leaves safe
+  CHECK(r.t_back_operate_s < 0);
+  LONGS_EQUAL(0, r.rows.back().exc);
+}

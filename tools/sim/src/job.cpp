@@ -359,9 +359,31 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   bool have_ref = false;
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
+  std::size_t next_fault = 0;
+  fw::Mode last_mode = fw::Mode::power_up;
   for (uint64_t k = 0; k < frames; ++k) {
+    while (next_fault < job.faults.size() &&
+           job.faults[next_fault].t_s <= static_cast<double>(k) / fw::kBaseRateHz) {
+      const FaultEvent& e = job.faults[next_fault++];
+      switch (e.kind) {
+        case FaultEvent::Kind::adc_stuck: target.set_adc_stuck(e.channel, e.on); break;
+        case FaultEvent::Kind::adc_saturated: target.set_adc_saturated(e.channel, e.on); break;
+        case FaultEvent::Kind::dac_dead: target.set_dac_dead(e.channel, e.on); break;
+        case FaultEvent::Kind::fault_input: target.set_fault_input(e.on); break;
+      }
+    }
     gyro->run_frame();
     const fw::GyroStatus& st = gyro->status();
+    if (st.mode != last_mode) {
+      ++r.mode_changes;
+      if ((st.mode == fw::Mode::fault || st.mode == fw::Mode::safe) && r.t_first_fault_s < 0) {
+        r.t_first_fault_s = st.chain.t_s;
+      }
+      if (st.mode == fw::Mode::operate && r.t_first_fault_s >= 0 && r.t_back_operate_s < 0) {
+        r.t_back_operate_s = st.chain.t_s;
+      }
+      last_mode = st.mode;
+    }
     r.faults_seen = static_cast<uint16_t>(r.faults_seen | st.faults);
     if (st.mode == fw::Mode::operate && !r.reached_operate) {
       r.reached_operate = true;

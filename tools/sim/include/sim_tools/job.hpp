@@ -21,6 +21,15 @@ struct Park {
   double t_end_s = 0.0;
 };
 
+// A fault injected through the simulated target's back door at time t_s.
+struct FaultEvent {
+  enum class Kind : uint8_t { adc_stuck, adc_saturated, dac_dead, fault_input };
+  double t_s = 0.0;
+  Kind kind = Kind::adc_stuck;
+  std::size_t channel = 0;  // ADC 0 = x, 1 = y; DAC 0 = pump, 1 = fx, 2 = fy
+  bool on = true;
+};
+
 // Everything the main job needs: the simulated target, the firmware and its
 // parts, the input schedule and what to record.
 struct JobConfig {
@@ -30,10 +39,11 @@ struct JobConfig {
   est::Estimator::Config estimator;
   double duration_s = 0.0;
   double latitude_deg = 55.75;
-  double earth_rate_rad_s = 0.0;  // vertical component of the Earth rate in the input
-  double telemetry_hz = 100.0;    // rows of telemetry.csv per simulated second
-  double sweep_end_s = 0.0;       // end of the turning (identification) phase
-  std::vector<Park> parks;        // the bias test (empty: none)
+  double earth_rate_rad_s = 0.0;   // vertical component of the Earth rate in the input
+  double telemetry_hz = 100.0;     // rows of telemetry.csv per simulated second
+  double sweep_end_s = 0.0;        // end of the turning (identification) phase
+  std::vector<Park> parks;         // the bias test (empty: none)
+  std::vector<FaultEvent> faults;  // in time order
   std::string description;
 };
 
@@ -123,6 +133,9 @@ struct JobResult {
   std::vector<TaskFigures> tasks;
   fw::FrameStats frames{};
   uint64_t can_frames = 0;
+  uint32_t mode_changes = 0;
+  double t_first_fault_s = -1.0;   // first frame in fault or safe
+  double t_back_operate_s = -1.0;  // first return to operate after that
   bool real_time = false;
   std::string realtime_setup;         // what SCHED_FIFO / mlockall gave (real time only)
   std::vector<std::string> failures;  // empty: the run passed
