@@ -205,7 +205,12 @@ TEST(SharedExamples, LabRingDownCampaignReadsWhole) {
   const char* src = std::getenv("HRG_SOURCE_DIR");
   CHECK_TRUE(src != nullptr);
   const fs::path p = fs::path(src) / ".." / "shared" / "examples" / "ringdown-baseline.csv.gz";
-  const Recording r = hrg::recording::read_recording(p);
+  Recording r;
+  try {
+    r = hrg::recording::read_recording(p);
+  } catch (const RecordingError& e) {
+    FAIL(e.what());
+  }
   // 119925 lines = version + 3 metadata + header + rows.
   LONGS_EQUAL(119925 - 5, r.rows());
   DOUBLES_EQUAL(5003.262, r.f_ref_hz(), 1e-9);
