@@ -105,3 +105,26 @@ TEST(FakeChain, MovesThePatternTowardsTheTarget) {
     c.process(adc, dac, cmd, out);
   DOUBLES_EQUAL(0.2, c.theta(), 1e-12);
 }
+
+TEST_GROUP(FakeIdentifier){};
+
+TEST(FakeIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsItsBackDoorValues) {
+  hrg::fakes::FakeIdentifier id;
+  hrg::fw::ChainOutputs s;
+  id.add_sample(s);  // outside a window: not counted
+  id.begin_window(1.5);
+  id.add_sample(s);
+  id.add_sample(s);
+  id.end_window();
+  id.begin_window(2.0);
+  id.abort_window();
+  LONGS_EQUAL(2, id.samples);
+  LONGS_EQUAL(2, id.begun);
+  LONGS_EQUAL(1, id.ended);
+  LONGS_EQUAL(1, id.aborted);
+  DOUBLES_EQUAL(2.0, id.last_begin_s, 0.0);
+  id.drift = 3e-4;
+  id.health_ = {true, 12.0, 0.5};
+  DOUBLES_EQUAL(3e-4, id.drift_rad_s(0.1, 0.0), 0.0);
+  DOUBLES_EQUAL(12.0, id.health().condition, 0.0);
+}
