@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
 
 namespace hrg::hal::linux_board {
 
@@ -31,7 +32,46 @@ std::size_t block_bytes(const StreamConfig& c, std::size_t channels) {
   return static_cast<std::size_t>(c.info.block_frames) * channels * c.format.storage_bytes;
 }
 
+bool read_uint(const char*& p, unsigned& out) {
+  if (*p < '0' || *p > '9') return false;
+  unsigned v = 0;
+  while (*p >= '0' && *p <= '9' && v < 1000)
+    v = v * 10 + static_cast<unsigned>(*p++ - '0');
+  out = v;
+  return true;
+}
+
 }  // namespace
+
+bool parse_iio_type(const char* text, SampleFormat& out) {
+  if (text == nullptr) return false;
+  SampleFormat f;
+  const char* p = text;
+  if (std::strncmp(p, "le:", 3) == 0) {
+    f.big_endian = false;
+  } else if (std::strncmp(p, "be:", 3) == 0) {
+    f.big_endian = true;
+  } else {
+    return false;
+  }
+  p += 3;
+  if (*p != 's' && *p != 'u') return false;
+  f.is_signed = *p++ == 's';
+  unsigned bits = 0;
+  unsigned storage = 0;
+  unsigned shift = 0;
+  if (!read_uint(p, bits) || *p++ != '/' || !read_uint(p, storage)) return false;
+  if (std::strncmp(p, ">>", 2) != 0) return false;
+  p += 2;
+  if (!read_uint(p, shift) || *p != '\0') return false;
+  if (storage % 8 != 0 || bits > 32 || storage > 32 || shift > 32) return false;
+  f.bits = static_cast<uint8_t>(bits);
+  f.storage_bytes = static_cast<uint8_t>(storage / 8);
+  f.shift = static_cast<uint8_t>(shift);
+  if (!valid(f)) return false;
+  out = f;
+  return true;
+}
 
 bool valid(const SampleFormat& f) {
   const bool storage_ok = f.storage_bytes == 1 || f.storage_bytes == 2 || f.storage_bytes == 4;

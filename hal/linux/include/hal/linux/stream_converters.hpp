@@ -90,5 +90,8 @@ class StreamDac final : public Dac {
 sample_q31 decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped);
 void encode_sample(sample_q31 word, const SampleFormat& f, uint8_t* p);
 bool valid(const SampleFormat& f);
+// Parses an IIO scan element type ("le:s16/16>>0", "be:u12/16>>4"; a repeat
+// count "X2" is not supported). Returns false for anything else.
+bool parse_iio_type(const char* text, SampleFormat& out);
 
 }  // namespace hrg::hal::linux_board
