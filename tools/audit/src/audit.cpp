@@ -73,6 +73,7 @@ class Auditor {
   double heldout_rms(const Mask& mask, const Params& start);
   std::string impact(Effect e, double v, const Params& p) const;
   void fill_plot(const Params& before, const Params& after, PlotData& plot) const;
+  void add_candidate_locations(AuditResult& out) const;
 
   AuditOptions opt_;
   Dataset d_;
@@ -215,6 +216,63 @@ void Auditor::fill_plot(const Params& before, const Params& after, PlotData& plo
       plot.res_before.push_back(rms4(rb));
       plot.res_after.push_back(rms4(ra));
     }
+  }
+}
+
+// Where each candidate sees the baseline's misfit, with the range of the
+// quantity it follows (amplitude, temperature, pump voltage).
+void Auditor::add_candidate_locations(AuditResult& out) const {
+  double a_lo = 1e300, a_hi = 0.0, t_lo = 1e300, t_hi = -1e300, v_lo = 1e300, v_hi = 0.0;
+  for (const auto& b : d_.blocks) {
+    a_lo = std::min(a_lo, b.a2_v2), a_hi = std::max(a_hi, b.a2_v2);
+    t_lo = std::min(t_lo, b.temp_c), t_hi = std::max(t_hi, b.temp_c);
+  }
+  for (const auto& f : d_.forced)
+    v_lo = std::min(v_lo, f.mean_v2), v_hi = std::max(v_hi, f.mean_v2);
+  char buf[200];
+  for (const auto& c : out.candidates) {
+    // The edge statistic is only meaningful against the final model (locate()).
+    if (!c.testable || c.delta_bic <= 0.0 || c.effect == Effect::drive_feedthrough) continue;
+    std::string signal, where;
+    switch (c.effect) {
+      case Effect::pickoff_gain_mismatch:
+        signal = "a_A (measured amplitude)",
+        where = "4-theta pattern in the level of the free decays";
+        break;
+      case Effect::pickoff_phase_mismatch:
+        signal = "a_B (quadrature)", where = "static quadrature depending on the pattern angle";
+        break;
+      case Effect::pickoff_misalignment:
+        signal = "theta_A, a_A", where = "sin-4-theta distortion of the readout";
+        break;
+      case Effect::duffing_stiffness:
+      case Effect::nonlinear_damping:
+        std::snprintf(buf, sizeof buf, "against a_A^2 over %.3g-%.3g V^2 (free decays)", a_lo,
+                      a_hi);
+        signal = c.effect == Effect::duffing_stiffness ? "wave frequency" : "decay rate",
+        where = buf;
+        break;
+      case Effect::thermal_frequency:
+      case Effect::thermal_damping:
+        std::snprintf(buf, sizeof buf, "against temperature over %.2f-%.2f degC", t_lo, t_hi);
+        signal = c.effect == Effect::thermal_frequency ? "wave frequency" : "decay rate",
+        where = buf;
+        break;
+      case Effect::electrostatic_spring:
+        std::snprintf(buf, sizeof buf,
+                      "excitation segments against free decays, pump_v^2 %.3g-%.3g V^2", v_lo,
+                      v_hi);
+        signal = "wave frequency", where = buf;
+        break;
+      case Effect::drive_feedthrough:
+        signal = "cx_v,sx_v,cy_v,sy_v", where = "steps at the switch-offs of exc";
+        break;
+    }
+    const bool dup = std::any_of(out.locations.begin(), out.locations.end(),
+                                 [&](const Location& l) { return l.where == where; });
+    if (!dup)
+      out.locations.push_back(
+          {signal, where + " (as " + effect_info(c.effect).id + ")", c.delta_bic});
   }
 }
 
@@ -457,6 +515,10 @@ AuditResult Auditor::run(PlotData* plot) {
     out.findings.push_back(f);
   }
   out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.use_forced, ft);
+  add_candidate_locations(out);
+  std::sort(out.locations.begin(), out.locations.end(),
+            [](const Location& a, const Location& b) { return a.score > b.score; });
+  if (out.locations.size() > 8) out.locations.resize(8);
 
   std::sort(out.findings.begin(), out.findings.end(),
             [](const Finding& a, const Finding& b) { return a.delta_bic > b.delta_bic; });
