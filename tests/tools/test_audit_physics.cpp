@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <string>
 
 #include "audit/audit.hpp"
@@ -79,4 +80,41 @@ TEST(AuditSimulated, ElectrostaticSpringIsTheFrequencyShiftWhilePumping) {
   CHECK(!r.findings.empty());
   CHECK(r.findings.front().effect == Effect::electrostatic_spring);
   DOUBLES_EQUAL(c, r.findings.front().value, 0.2 * std::abs(c));
+}
+
+TEST(AuditSimulated, NoiseCorrelatedOverSamplesIsNotStructure) {
+  // GIVEN a null campaign whose noise went through a first-order low-pass
+  // (a lock-in's output filter: correlation 0.8 from sample to sample)
+  auto s = hrg::audit::bench::random_scenario(hrg::audit::bench::Design::ringdown, 300.0, 11);
+  const double sigma = s.noise_v;
+  s.noise_v = 0.0;
+  auto rec = hrg::audit::bench::simulate(s);
+  std::mt19937_64 g(5);
+  std::normal_distribution<double> n(0.0, sigma * std::sqrt(1.0 - 0.64));
+  for (const char* c : {"cx_v", "sx_v", "cy_v", "sy_v"}) {
+    double state = 0.0;
+    for (double& v : rec.column(c)) {
+      state = 0.8 * state + n(g);
+      v += state;
+    }
+  }
+  // THEN the audit finds nothing and calls nothing unexplained
+  const AuditResult r = hrg::audit::run_audit(rec);
+  STRCMP_EQUAL("consistent", r.verdict.c_str());
+}
+
+TEST(AuditSimulated, StructureOutsideTheCatalogueIsUnexplained) {
+  // GIVEN a null campaign with a 0.05 Hz tone of 10 noise sigmas added to cx
+  auto s = hrg::audit::bench::random_scenario(hrg::audit::bench::Design::ringdown, 300.0, 11);
+  auto rec = hrg::audit::bench::simulate(s);
+  const auto& t = rec.column("t_s");
+  auto& cx = rec.column("cx_v");
+  for (std::size_t i = 0; i < cx.size(); ++i) {
+    cx[i] += 10.0 * s.noise_v * std::sin(2.0 * M_PI * 0.05 * t[i]);
+  }
+  // THEN it is reported as unexplained, and not forced onto a catalogue name
+  const AuditResult r = hrg::audit::run_audit(rec);
+  STRCMP_EQUAL("unexplained", r.verdict.c_str());
+  LONGS_EQUAL(0, r.findings.size());
+  CHECK(!r.unexplained_note.empty());
 }

@@ -309,6 +309,50 @@ AuditResult Auditor::run(PlotData* plot) {
   // Baseline on the free decays alone, then the excitation-segment frequencies
   // join with their scatter as weight.
   State cur = fit_state(base, p0, false);
+  {
+    // Noise correlated over a few samples makes the block means noisier than
+    // the white level from second differences of the samples says. Measure the
+    // block noise from second differences of the baseline's block residuals
+    // (slow structure cancels there, noise does not) and use the larger.
+    // Stride m between the blocks of the difference: grows while the noise
+    // is still correlated (modest growth); slow structure would grow ~m^4
+    // and stops the search.
+    auto second_diff_var = [&](std::size_t m) {
+      double acc = 0.0, cnt = 0.0;
+      std::size_t k0 = 0;
+      for (const auto& seg : d_.free) {
+        for (std::size_t b = 2 * m; b < seg.n_blocks; ++b) {
+          const std::size_t k = k0 + 4 * b;
+          for (std::size_t c = 0; c < 4; ++c) {
+            const double d2 =
+                cur.res[k + c] - 2.0 * cur.res[k - 4 * m + c] + cur.res[k - 8 * m + c];
+            acc += d2 * d2, cnt += 6.0;
+          }
+        }
+        k0 += 4 * seg.n_blocks;
+      }
+      return cnt > 0.0 ? acc / cnt : 1.0;
+    };
+    double lambda = second_diff_var(1);
+    for (std::size_t m = 2; m <= 8; m *= 2) {
+      const double next = second_diff_var(m);
+      if (next > 4.0 * lambda) break;
+      lambda = std::max(lambda, next);
+    }
+    if (lambda > 1.2) {
+      const double f = std::sqrt(lambda);
+      d_.noise_v *= f;
+      for (auto& fs : d_.forced)
+        fs.se_rad_s *= f;
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "noise is correlated over samples: block noise %.2f x the white level of the "
+                    "samples, used as the noise",
+                    f);
+      out.notes.push_back(buf);
+      cur = fit_state(base, cur.fit.p, false);
+    }
+  }
   if (d_.forced.size() >= 3) {
     // Weight of each excitation segment: its white-noise error and the
     // scatter the baseline leaves beyond it. The scatter is measured after

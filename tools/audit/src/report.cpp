@@ -128,7 +128,7 @@ std::string to_text(const AuditResult& r, const std::string& source) {
   }
   std::snprintf(buf, sizeof buf,
                 "\nFit (free-decay rms per sample): baseline %.3g V -> final %.3g V; held-out "
-                "segments %.3g V -> %.3g V; white noise %.3g V\n",
+                "segments %.3g V -> %.3g V; noise %.3g V\n",
                 r.fit_rms_before_v, r.fit_rms_after_v, r.heldout_rms_v, r.heldout_rms_final_v,
                 r.noise_v);
   t += buf;
