@@ -20,8 +20,8 @@ const std::vector<Step>& script();
 // Checks a candump -L capture of a scripted rig run; prints figures; 0 = pass.
 int check_log(const char* path);
 // Checks a candump -L capture of hrg-board (the firmware on this target): all
-// telemetry present (at most 1 % lost), a status request accepted, a window
-// command refused (that build has no run-time settings).
+// telemetry present (at most 1 % lost), a status request and a window
+// schedule accepted by the firmware's command task.
 int check_firmware_log(const char* path);
 // Writes a deterministic telemetry log with CandumpLogWriter (for canplayer).
 int write_replay_log(const char* path);

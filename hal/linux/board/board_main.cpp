@@ -3,11 +3,10 @@
 // simulated converters of sim_target behind the ADC/DAC seam (no hardware
 // needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
-// Telemetry goes out on IF at the default rates; commands on IF are validated
-// and answered (mode safe / ring-up act, a status request is answered by the
-// next periodic HRG_STATUS; this firmware
-// build has no run-time settings, so window, AGC and identification commands
-// are refused as wrong_state). Runs until SIGTERM/SIGINT or S seconds.
+// The firmware sends its telemetry on IF at the default rates and answers the
+// commands of the DBC with its own command task; the board adds the receive
+// filter and restarts the controller after 100 ms of bus-off. Runs until
+// SIGTERM/SIGINT or S seconds.
 #include <signal.h>
 
 #include <cmath>
@@ -125,6 +124,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hrg-board: converters do not match the firmware's block layout\n");
     return 1;
   }
+  // The firmware's command task receives and answers commands itself; the
+  // board adds the command filter and the bus-off restart policy.
   fw::can::CanLink link(can, fw::kBaseRateHz / 10);
   link.init();
 
@@ -141,18 +142,6 @@ int main(int argc, char** argv) {
     const fw::GyroStatus& st = gyro->status();
     if (st.enable_line != last_exc) ++exc_edges;
     last_exc = st.enable_line;
-    fw::can::ControllerView view{st.mode, st.faults, st.fault_input, false, 0.0, false};
-    fw::can::Command cmd;
-    while (link.poll(view, cmd)) {
-      if (cmd.id == fw::can::Cmd::set_mode) {
-        if (cmd.mode == fw::Mode::safe) gyro->command_safe();
-        if (cmd.mode == fw::Mode::ring_up) gyro->command_restart();
-      }
-      // A status request is answered by the reply and the next periodic
-      // HRG_STATUS (10 Hz): the firmware owns that message's sequence counter,
-      // so a second encoder here would break the loss count.
-      view.mode = gyro->status().mode;
-    }
     link.service();
   }
   const auto& fs = gyro->executive().frame_stats();
@@ -164,8 +153,7 @@ int main(int argc, char** argv) {
       static_cast<double>(k) / fw::kBaseRateHz, o.can.c_str(),
       static_cast<unsigned long long>(fs.frames), fs.deadline_misses, fs.missed_frames,
       fs.max_frame_ns * 1e-6, static_cast<int>(gyro->status().mode), gyro->status().faults,
-      exc_edges, link.stats().commands_accepted, link.stats().commands_refused, c.tx_frames,
-      gyro->can_tx_refused() + link.stats().tx_refused, c.tx_queue_full, c.bus_off_events,
-      c.restarts);
+      exc_edges, gyro->commands_accepted(), gyro->commands_refused(), c.tx_frames,
+      gyro->can_tx_refused(), c.tx_queue_full, c.bus_off_events, c.restarts);
   return 0;
 }
