@@ -155,6 +155,7 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   Vec4 best_c = Vec4::Zero();
   double best_cost = 1e300;
   for (double rel : {1.0, -1.0}) {
+    double sigma = 0.0;
     const cplx cx = std::sqrt(m[0]), cy = rel * std::sqrt(m[1]);
     Vec4 c = real4({cx, cy});
     double cost = 0.0;
@@ -172,10 +173,14 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
       c = a.ldlt().solve(rhs);
       if (it == 3) {
         const Eigen::Matrix4d cov = a.inverse();
-        fs.sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0);
+        // Scaled by the scatter of the edges about the fit when it exceeds
+        // the noise (extrapolation errors the noise alone does not cover).
+        const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
+        sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0 *
+                          std::max(1.0, cost / dof));
       }
     }
-    if (cost < best_cost) best_cost = cost, best_c = c;
+    if (cost < best_cost) best_cost = cost, best_c = c, fs.sigma = sigma;
   }
   fs.c_x = std::hypot(best_c(0), best_c(1));
   fs.c_y = std::hypot(best_c(2), best_c(3));
