@@ -28,8 +28,8 @@ Mat2 dynamics(const Params& p, const Dataset& d, const Inputs& in) {
   // Both circular modes of eq. 1 ring at sqrt(w^2 + (Omega K)^2) -+ Omega K:
   // the common second-order shift (Omega K)^2 / 2w moves the phase.
   const double ok2 = in.rate_rad_s * p[kK] * in.rate_rad_s * p[kK];
-  const double dw0 = p[kDw0] + ok2 / (4.0 * kPi * d.f_ref_hz) + 2.0 * kPi * p[kDuff] * in.a2_v2 +
-                     2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
+  const double dw0 = p[kDw0] + p[kCor] * ok2 / (4.0 * kPi * d.f_ref_hz) +
+                     2.0 * kPi * p[kDuff] * in.a2_v2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
   const double s = (1.0 + p[kNld] * in.a2_v2) * (1.0 + p[kTd] * dT);
   const double ok = in.rate_rad_s * p[kK];
   return {kI * (dw0 + p[kDwC]) - s * (p[kNu] + p[kDnuC]), kI * p[kDwS] - s * p[kDnuS] + ok,
@@ -110,7 +110,7 @@ double measured_phase(const Params& p, double theta) {
 
 double param_scale(int p) {
   static constexpr double kScale[kParamCount] = {1e-3, 1e-3, 1e-4, 1e-4, 1e-4, 1e-4, 1e-3, 1e-3,
-                                                 1e-3, 1e-3, 1e-4, 1e-3, 1e-1, 1e-3, 1e-6};
+                                                 1e-3, 1e-3, 1e-4, 1e-3, 1e-1, 1e-3, 1e-6, 1e-1};
   return kScale[p];
 }
 
@@ -137,7 +137,7 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
   for (const auto& f : d.forced) {
     const double dT = f.mean_temp_c - d.temp_ref_c;
     const double okf = f.mean_rate_rad_s * p[kK];
-    double w = p[kDw0] + okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
+    double w = p[kDw0] + p[kCor] * okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
                p[kDwS] * f.mean_s4 + 2.0 * kPi * p[kDuff] * f.mean_a2 +
                2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT + 2.0 * kPi * p[kEs] * f.mean_v2;
     double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);

@@ -34,6 +34,8 @@ enum Param : int {
   kTf,     // thermal_frequency, ppm/degC
   kTd,     // thermal_damping, 1/degC
   kEs,     // electrostatic_spring, Hz/V^2
+  kCor,    // factor on the second-order Coriolis shift (Omega K)^2/2w: 1 for eq. 1;
+           // fitted as a nuisance because first-order averaged simulators leave it out
   kParamCount
 };
 

@@ -211,7 +211,7 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
   std::vector<SegScore> segs;
   // Harmonics of the amplitude and quadrature residuals against 4 theta.
   double sa[3][3] = {}, sq[3][3] = {};
-  double ya[3] = {}, yq[3] = {}, saa = 0.0, sqq = 0.0;
+  double ya[3] = {}, yq[3] = {};
   std::vector<std::array<cplx, 2>> pred;
   std::vector<double> tmp;
   evaluate(d, p, EvalOptions{}, tmp, &pred);
@@ -236,7 +236,6 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
         for (int j = 0; j < 3; ++j)
           sa[i][j] += f[i] * f[j], sq[i][j] += f[i] * f[j];
       }
-      saa += da * da, sqq += dq * dq;
     }
     const double dof = 4.0 * static_cast<double>(s.n_blocks);
     segs.push_back({chi - dof, si});
@@ -309,8 +308,6 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
                    ft.dchi2});
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });
-  (void)saa;
-  (void)sqq;
   return out;
 }
 
