@@ -421,6 +421,9 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   r.sim_s = job.duration_s;
   r.realtime_factor = r.wall_s > 0 ? r.sim_s / r.wall_s : 0.0;
   r.realtime_factor_cpu = r.cpu_s > 0 ? r.sim_s / r.cpu_s : 0.0;
+  r.adc_wait_mean_us =
+      frames ? static_cast<double>(gyro->status().adc_wait_ns) * 1e-3 / static_cast<double>(frames)
+             : 0.0;
   r.sim_share =
       r.wall_s > 0 ? static_cast<double>(gyro->status().adc_wait_ns) * 1e-9 / r.wall_s : 0.0;
   r.final_mode = gyro->status().mode;

@@ -111,6 +111,7 @@ struct JobResult {
   double realtime_factor = 0.0;      // simulated s per wall s
   double realtime_factor_cpu = 0.0;  // simulated s per CPU s (what one free core gives)
   double sim_share = 0.0;            // share of the wall time spent in the simulated ADC (physics)
+  double adc_wait_mean_us = 0.0;     // mean time per frame inside Adc::read_block (the simulation)
   double excitation_off_fraction = 0.0;
   uint32_t windows = 0;
   uint32_t windows_accepted = 0;
