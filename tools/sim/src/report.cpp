@@ -148,6 +148,16 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.end_object();
 
   w.number("allan_span_s", r.allan_span_s);
+  // The flat bottom of the curve (IEEE 952 bias instability, before the 0.664 factor).
+  double adev_min = 0, tau_min = 0;
+  for (const auto& p : r.allan) {
+    if (adev_min == 0 || p.adev < adev_min) {
+      adev_min = p.adev;
+      tau_min = p.tau_s;
+    }
+  }
+  w.number("allan_min_dph", adev_min * kRadSToDph);
+  w.number("allan_min_tau_s", tau_min);
   w.begin_array("allan_deviation");
   for (const auto& p : r.allan) {
     w.begin_object();
@@ -259,6 +269,15 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   run.row({"tracking rms", fmt("%.4f deg (max %.4f)", r.tracking_rms_deg, r.tracking_max_deg)});
   run.row({"error at end", fmt("raw %.4f deg, model %.4f deg, compensated %.4f deg",
                                r.raw_error_end_deg, r.model_error_end_deg, r.comp_error_end_deg)});
+  double adev_min = 0, tau_min = 0;
+  for (const auto& p : r.allan) {
+    if (adev_min == 0 || p.adev < adev_min) {
+      adev_min = p.adev;
+      tau_min = p.tau_s;
+    }
+  }
+  run.row({"Allan deviation", fmt("min %.3f deg/h at %.1f s (over a %.0f s still record)",
+                                  adev_min * kRadSToDph, tau_min, r.allan_span_s)});
   run.print(out);
 
   TextTable id("identification (estimate +- sigma, truth)");
