@@ -212,8 +212,11 @@ std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p,
     const cplx zx = e[0] * zr[0] + e[1] * zr[1];
     const cplx zy = e[2] * zr[0] + e[3] * zr[1];
     if (i == 0 && wave_phase_rad) {
-      *wave_phase_rad =
-          dsp::wave_variables<double>({zx.real(), -zx.imag(), zy.real(), -zy.imag()}).phase_rad;
+      // Phase of the A wave with theta_A = atan2(S, R)/4 in (-pi/4, pi/4]: the
+      // usual convention, so a drive that follows the wave keeps its sign.
+      const double th =
+          dsp::wave_variables<double>({zx.real(), -zx.imag(), zy.real(), -zy.imag()}).theta_A_rad;
+      *wave_phase_rad = std::arg(zx * std::cos(2.0 * th) + zy * std::sin(2.0 * th));
     }
     out.push_back({c[0] * zx + c[1] * zy, c[2] * zx + c[3] * zy});
   }

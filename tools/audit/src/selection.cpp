@@ -151,36 +151,55 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   fs.testable = true;
   fs.edges = static_cast<int>(n);
   fs.threshold = std::pow(4.0 * ln_neff * s4 / n, 0.25);
-  // Estimate: least squares with one sign per edge, from the moment estimate.
-  Vec4 best_c = Vec4::Zero();
-  double best_cost = 1e300;
-  for (double rel : {1.0, -1.0}) {
-    double sigma = 0.0;
-    const cplx cx = std::sqrt(m[0]), cy = rel * std::sqrt(m[1]);
-    Vec4 c = real4({cx, cy});
-    double cost = 0.0;
-    for (int it = 0; it < 4; ++it) {
+  // Estimate: least squares, first with the sign the wave phase convention
+  // gives, then with one sign per edge (for a source whose drive phase flips
+  // by pi with another convention); the free signs are taken only when they
+  // fit much better than the freedom they add.
+  auto solve = [&](bool free_signs, Vec4 c, double& cost, double& sigma) {
+    for (int it = 0; it < (free_signs ? 5 : 1); ++it) {
       Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
       Vec4 rhs = Vec4::Zero();
+      for (const auto& ej : jumps) {
+        const Eigen::Matrix4d f = feed_map(ej);
+        const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
+        a += f.transpose() * f / ej.var;
+        rhs += sgn * f.transpose() * ej.j / ej.var;
+      }
+      c = a.ldlt().solve(rhs);
       cost = 0.0;
       for (const auto& ej : jumps) {
         const Eigen::Matrix4d f = feed_map(ej);
-        const double sgn = ej.j.dot(f * c) >= 0.0 ? 1.0 : -1.0;
-        a += f.transpose() * f / ej.var;
-        rhs += sgn * f.transpose() * ej.j / ej.var;
+        const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
         cost += (ej.j - sgn * f * c).squaredNorm() / ej.var;
       }
-      c = a.ldlt().solve(rhs);
-      if (it == 3) {
-        const Eigen::Matrix4d cov = a.inverse();
-        // Scaled by the scatter of the edges about the fit when it exceeds
-        // the noise (extrapolation errors the noise alone does not cover).
-        const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
-        sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0 *
-                          std::max(1.0, cost / dof));
-      }
+      // Scaled by the scatter of the edges about the fit when it exceeds the
+      // noise (extrapolation errors the noise alone does not cover).
+      const Eigen::Matrix4d cov = a.inverse();
+      const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
+      sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0 *
+                        std::max(1.0, cost / dof));
     }
-    if (cost < best_cost) best_cost = cost, best_c = c, fs.sigma = sigma;
+    return c;
+  };
+  double fixed_cost = 0.0, fixed_sigma = 0.0;
+  Vec4 best_c = solve(false, Vec4::Zero(), fixed_cost, fixed_sigma);
+  fs.sigma = fixed_sigma;
+  double best_cost = 1e300, best_sigma = 0.0;
+  Vec4 free_c = Vec4::Zero();
+  for (double rel : {1.0, -1.0}) {
+    double cost = 0.0, sigma = 0.0;
+    const Vec4 c = solve(true, real4({std::sqrt(m[0]), rel * std::sqrt(m[1])}), cost, sigma);
+    if (cost < best_cost) best_cost = cost, free_c = c, best_sigma = sigma;
+  }
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    std::fprintf(
+        stderr, "feedthrough: fixed-sign cost %.1f |c| %.3g, free-sign cost %.1f |c| %.3g\n",
+        fixed_cost, std::max(std::hypot(best_c(0), best_c(1)), std::hypot(best_c(2), best_c(3))),
+        best_cost, std::max(std::hypot(free_c(0), free_c(1)), std::hypot(free_c(2), free_c(3))));
+  }
+  if (fixed_cost - best_cost > 2.0 * static_cast<double>(jumps.size()) + 25.0) {
+    best_c = free_c;
+    fs.sigma = best_sigma;
   }
   fs.c_x = std::hypot(best_c(0), best_c(1));
   fs.c_y = std::hypot(best_c(2), best_c(3));
