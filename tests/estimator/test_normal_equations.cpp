@@ -132,7 +132,7 @@ TEST(NormalEquations, SplitOnlyTakesTheCoverageMeanOfTheAnisotropyIntoNu) {
   DOUBLES_EQUAL(p(kNu) + mean_d, s.p(kNu), 0.01 * std::abs(mean_d));
   // AND the Q row has no anisotropy term, so the split is biased only through
   // its small nu column (-2 a_A a_B): relative error of order mean_d T
-  for (int i : {kDwC, kDwS})
+  for (int i = kDwC; i <= kDwS; ++i)
     DOUBLES_EQUAL(p(i), s.p(i), 3.0 * std::abs(mean_d) * M_PI * 5e-4);
   const ParamVector bias = omitted_bias(ls, {kNu, kDwC, kDwS}, {kDnuC, kDnuS}, p);
   for (int i : {kNu, kDwC, kDwS})
