@@ -162,10 +162,14 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
   return true;
 }
 
+double PumpDriftEstimator::kappa_2() const {
+  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  return conditioning_of<3>(n).kappa_2;
+}
+
 bool PumpDriftEstimator::valid() const {
   if (fit_s_ < config_.min_fit_s) return false;
-  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
-  return conditioning_of<3>(n).kappa_2 <= config_.max_kappa_2;
+  return kappa_2() <= config_.max_kappa_2;
 }
 
 Eigen::Vector3d PumpDriftEstimator::coefficients() const {

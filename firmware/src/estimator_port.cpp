@@ -28,13 +28,32 @@ void EstimatorPort::end_window() {
 }
 
 void EstimatorPort::abort_window() {
-  // est::Estimator has no abort: the samples fed before the abort (all taken
-  // before the fault monitors fired) are folded in, and the window is counted
-  // as aborted.
+  // A window cut short by a fault is dropped: its last samples may already
+  // show the fault, and a short window is worth little anyway.
   if (!est_.window().window_open()) return;
-  (void)est_.end_window();
-  dirty_ = true;
+  est_.abort_window();
   ++windows_bad_;
+}
+
+void EstimatorPort::add_control_sample(const ChainOutputs& s) {
+  // The D_Phi fits take the identified decay and split as known: before a
+  // model is accepted they would fold in a wrong one.
+  if (!est_.has_model()) return;
+  est::ControlDriftEstimator::Sample c;
+  c.t_s = s.t_s;
+  c.a_A_v = s.a_a_v;
+  c.a_B_v = s.a_b_v;
+  c.theta_A_rad = s.theta_a_rad;
+  c.pump_phase_error_rad = s.pump_phase_error_rad;
+  c.quad_force_sin_v_s = s.quad_sin_v_s;
+  c.quad_force_cos_v_s = s.quad_cos_v_s;
+  c.pump_v = s.pump_v;
+  // Samples are taken every control period in operate; a gap (a window, a
+  // commanded pattern move) ends the derivative blocks first.
+  if (s.t_s - last_control_t_s_ > kMaxControlGapS) est_.restart_control();
+  last_control_t_s_ = s.t_s;
+  // A bad sample restarts the estimate (the estimator's rule).
+  (void)est_.add_control_sample(c);
 }
 
 void EstimatorPort::solve() {

@@ -189,7 +189,13 @@ void Gyro::on_mode_change(Mode from, Mode to) {
 }
 
 void Gyro::task_identify(Gyro& g) {
-  if (g.mode_.mode() == Mode::free_decay) g.identifier_.add_sample(g.status_.chain);
+  if (g.mode_.mode() == Mode::free_decay) {
+    g.identifier_.add_sample(g.status_.chain);
+  } else if (g.mode_.mode() == Mode::operate && g.status_.excitation_on &&
+             !g.status_.pattern_control && g.pattern_hold_frames_ == 0) {
+    // D_Phi is estimated from the loops' effort while they hold the wave.
+    g.identifier_.add_control_sample(g.status_.chain);
+  }
 }
 
 void Gyro::task_output(Gyro& g) {
@@ -210,9 +216,17 @@ void Gyro::task_output(Gyro& g) {
   if (g.cfg_.identify ? g.scheduler_.campaign_done() : g.identifier_.health().solved) {
     g.compensation_ready_ = true;
   }
-  const double drift = g.cfg_.compensate_drift && g.compensation_ready_
-                           ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio)
-                           : 0.0;
+  double drift = g.cfg_.compensate_drift && g.compensation_ready_
+                     ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio)
+                     : 0.0;
+  // The control loops drift the pattern only while they drive it.
+  double control = 0.0;
+  if (g.cfg_.compensate_drift && g.cfg_.compensate_control_drift && g.compensation_ready_ &&
+      g.status_.excitation_on) {
+    control = g.identifier_.control_drift_rad_s(o.theta_a_rad);
+  }
+  drift += control;
+  g.status_.control_drift_rad_s = control;
   const bool valid = g.mode_.permissions().output_valid && !moving_on_purpose;
   g.output_.update(o.theta_a_rad, drift, valid);
   GyroStatus& s = g.status_;
@@ -296,6 +310,18 @@ void Gyro::task_commands(Gyro& g) {
   view.fault_input = g.status_.fault_input;
   view.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
   view.agc_setpoint_v = g.cfg_.amplitude_set_v;
+  // Bus-off recovery (the policy of can::CanLink::service): the controller
+  // stays off the bus for a while, then is restarted; nothing else would
+  // bring it back.
+  if (g.board_.can.state() == hal::CanState::bus_off) {
+    if (++g.can_off_runs_ >= kCanRestartRuns) {
+      g.can_off_runs_ = 0;
+      ++g.can_restarts_;
+      (void)g.board_.can.restart();
+    }
+    return;
+  }
+  g.can_off_runs_ = 0;
   for (uint32_t n = 0; n < kCommandsPerRun; ++n) {
     hal::CanFrame f;
     if (g.board_.can.receive(f) != hal::Status::ok) break;

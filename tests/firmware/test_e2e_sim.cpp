@@ -286,6 +286,79 @@ TEST(InjectedFaults, TheBoardFaultInputEndsInSafeWithTheDrivesOff) {
   LONGS_EQUAL(0, r.rows.back().exc);
 }
 
+TEST(InjectedFaults, AfterBusOffTheFirmwareRestartsTheCanControllerByItself) {
+  // GIVEN the simulated controller forced bus-off at 5 s (TX queue dropped,
+  // every send refused) and nothing else restarting it.
+  JobConfig j = hrg::simtools::static_base_job(8.0);
+  j.gyro.identify = false;
+  j.sim.initial.amplitude_v = 1.0;
+  j.faults = {{5.0, hrg::simtools::FaultEvent::Kind::can_bus_off, 0, true}};
+  const JobResult r = hrg::simtools::run_job(j, {});
+  // THEN the command task (100 Hz) restarts it after kCanRestartRuns runs
+  // bus-off, once, and telemetry is on the bus again within that time plus
+  // one frame; the gyro itself never left its modes for it.
+  LONGS_EQUAL(1, r.can_bus_off_events);
+  LONGS_EQUAL(1, r.can_restarts);
+  const double restart_s = hrg::fw::Gyro::kCanRestartRuns / 100.0;
+  CHECK(r.t_can_back_s > 5.0 + restart_s - 0.011);
+  CHECK(r.t_can_back_s < 5.0 + restart_s + 0.011);
+  CHECK(r.faults_seen == 0);
+}
+
+namespace {
+// The default run with and without the control-loop drift D_Phi in the
+// output; `gap` adds the pump electrode's gap harmonics (eps_p, eps_q).
+JobResult run_control(bool compensate, bool gap) {
+  JobConfig j = hrg::simtools::default_job(0.0, 16);
+  if (gap) {
+    j.sim.electrodes.eps_p = 0.02;
+    j.sim.electrodes.eps_q = 0.01;
+  }
+  j.gyro.compensate_control_drift = compensate;
+  return hrg::simtools::run_job(j, {});
+}
+}  // namespace
+
+TEST_GROUP(ControlLoopDrift){
+    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+}
+void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
+}
+;
+
+TEST(ControlLoopDrift, WithAnIdealPumpAddingDPhiDoesNotMakeTheBiasWorse) {
+  // GIVEN the default resonator and an ideal ring electrode: the control
+  // loops do not turn the pattern, so D_Phi is zero up to its noise and the
+  // residual mean bias is the parks' own noise (it scales with the ADC noise).
+  const JobResult off = run_control(false, false);
+  const JobResult on = run_control(true, false);
+  CHECK(off.fit_comp.ok && on.fit_comp.ok);
+  // THEN neither the ADB nor the mean bias moves by more than the mean's
+  // standard error from the parks' scatter.
+  const double se = off.fit_comp.sigma_b0;
+  CHECK(se > 0.0);
+  CHECK(on.fit_comp.amplitude() < off.fit_comp.amplitude() + 2.0 * se);
+  CHECK(std::fabs(on.fit_comp.b0 - off.fit_comp.b0) < 2.0 * se);
+}
+
+TEST(ControlLoopDrift, TheGapHarmonicsOfThePumpAreCompensated) {
+  // GIVEN a ring electrode gap with harmonics eps_p = 0.02, eps_q = 0.01:
+  // with the pump at kappa = nu (it holds the amplitude against damping) the
+  // pattern turns at D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th),
+  // amplitude nu |eps|/2 / K of input rate, which the free-decay windows
+  // (pump off) cannot see.
+  const JobResult off = run_control(false, true);
+  const JobResult on = run_control(true, true);
+  const JobConfig j = hrg::simtools::default_job(0.0, 16);
+  const double nu = j.sim.resonator.nu_per_s();
+  const double expected_dph = nu * std::hypot(0.02, 0.01) / 2.0 / j.gyro.angular_gain * kRadSToDph;
+  CHECK(off.fit_comp.ok && on.fit_comp.ok);
+  DOUBLES_EQUAL(expected_dph, off.fit_comp.amplitude(), 0.15 * expected_dph);
+  // THEN with D_Phi in the output the compensated ADB drops by at least 40 %
+  // within the 365 s run (the fit converges over the parks).
+  CHECK(on.fit_comp.amplitude() < 0.6 * off.fit_comp.amplitude());
+}
+
 TEST_GROUP(Lockstep){void setup()
                          override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
 }

@@ -23,7 +23,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
     "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
-    "               [--quiet]\n\n"
+    "               [--no-control-drift] [--quiet]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -36,6 +36,8 @@ constexpr const char* kUsage =
     "(pattern-angle command) to fill the 4 theta bins between windows.\n"
     "--real-time paces the same executive by CLOCK_MONOTONIC (1 ms frames,\n"
     "SCHED_FIFO and mlockall when permitted) and counts deadline misses.\n"
+    "--no-control-drift leaves the control-loop drift D_Phi out of the output\n"
+    "(the resonator model is still applied), for comparison.\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
 
 bool parse_double(std::string_view s, double& out) {
@@ -57,6 +59,7 @@ int sim_main(std::span<char* const> args) {
   double duration_s = 0.0;
   int bias_angles = 16;
   bool plots = true, quiet = false, real_time = false, static_base = false;
+  bool control_drift = true;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
     const auto value = [&](const char* what) -> const char* {
@@ -101,6 +104,8 @@ int sim_main(std::span<char* const> args) {
       static_base = true;
     } else if (a == "--real-time") {
       real_time = true;
+    } else if (a == "--no-control-drift") {
+      control_drift = false;
     } else if (a == "--no-plots") {
       plots = false;
     } else if (a == "--quiet") {
@@ -124,6 +129,7 @@ int sim_main(std::span<char* const> args) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
   }
+  job.gyro.compensate_control_drift = control_drift;
   const std::filesystem::path dir(out_dir);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -163,6 +163,10 @@ class PumpDriftEstimator {
   // Ends the present segment (call when a free-decay window starts).
   void restart();
   bool valid() const;
+  // Excitation-on time folded into the fit (s) and the 2-norm condition
+  // number of its 3x3 normal matrix (what valid() compares).
+  double fit_s() const { return fit_s_; }
+  double kappa_2() const;
   // D_Phi of the pump at pattern angle theta for the last pump drive, rad/s.
   double d_phi_rad_s(double theta_A_rad) const;
   // (b0, b1, b2) = c (1, eps_p/2, eps_q/2); zero before valid().

@@ -69,7 +69,19 @@ class Estimator {
   }
   // Control-rate output correction; D_Phi is added only with excitation on.
   double step_output(double theta_A_rad, double aB_over_aA, double dt_s, bool excitation_on);
-  bool add_control_sample(const ControlDriftEstimator::Sample& s) { return control_.add_sample(s); }
+  // Feeds both D_Phi estimators (eq. 23 and the pump's gap part); false if
+  // either refused the sample (it then restarts).
+  bool add_control_sample(const ControlDriftEstimator::Sample& s) {
+    const bool control_ok = control_.add_sample(s);
+    const bool pump_ok = pump_.add_sample(s);
+    return control_ok && pump_ok;
+  }
+  // Ends the D_Phi derivative blocks when the control samples stop for a
+  // while (e.g. a commanded pattern move) without touching the window.
+  void restart_control() {
+    control_.restart();
+    pump_.restart();
+  }
 
   bool has_model() const { return comp_.has_model(); }
   const ParamVector& model() const { return comp_.model(); }

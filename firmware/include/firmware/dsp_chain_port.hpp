@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstdint>
 #include <span>
 
 #include "dsp/chain.hpp"
@@ -9,27 +10,54 @@
 
 namespace hrg::fw {
 
-// The firmware's SignalChain over dsp::Chain: the mode policy switches the
-// chain's excitation (pump and forcers together), the pattern command steers
-// theta_A, and the chain's slow outputs become ChainOutputs. The fast path is
-// Q1.31 (bit-exact with the Cortex-M7 build).
+// The converters as the chain must know them (from the board's data sheet or
+// the simulated target's configuration).
+struct ConverterInfo {
+  double sample_rate_hz = 100000.0;
+  uint32_t block_frames = 100;
+  double adc_full_scale_v = 2.0;     // pickoff volts at Q1.31 full scale
+  double dac_full_scale_v = 10.0;    // electrode volts at Q1.31 full scale
+  double dac_latency_samples = 0.0;  // DAC pipeline, frames
+};
+
+// `base` with the converter fields filled in: the DAC block written after ADC
+// block n acts one block later, plus half a frame of zero-order hold, plus
+// the DAC's pipeline.
+dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig base = {});
+
+// Fastest pattern turn the forcers can make at the set point (rad/s of
+// theta_A): theta_A' = g u_r / (4 w a_A) with u_r at forcer_max_v, less
+// `margin` for the quadrature loop that shares the forcers.
+double max_pattern_rate_rad_s(const dsp::ChainConfig& cfg, double margin = 0.8);
+
+// The firmware's SignalChain over dsp::Chain: the mode policy gates the pump
+// and the forcers separately, the pattern command steers theta_A (at no more
+// than the forcers can do), and the chain's slow outputs become ChainOutputs.
+// The fast path is Q1.31 (bit-exact with the Cortex-M7 build).
 class DspChainPort final : public SignalChain {
  public:
   using Sample = dsp::q31_t;
 
-  // `cfg` must pass dsp::check_chain_config (usable() tells).
-  explicit DspChainPort(const dsp::ChainConfig& cfg, double pattern_max_rate_rad_s = 0.5)
-      : chain_(cfg), pattern_max_rate_rad_s_(pattern_max_rate_rad_s) {}
+  // `cfg` is checked with dsp::check_chain_config: error() names the bad
+  // field and process() then keeps the drives at zero. A non-positive
+  // `pattern_max_rate_rad_s` takes the forcers' limit; a larger one is clamped to it.
+  explicit DspChainPort(const dsp::ChainConfig& cfg, double pattern_max_rate_rad_s = 0.0);
 
   void process(std::span<const hal::sample_q31> adc, std::span<hal::sample_q31> dac,
                const ChainCommands& cmd, ChainOutputs& out) override;
 
-  bool usable() const { return dsp::check_chain_config(chain_.config()) == nullptr; }
+  bool usable() const { return error_ == nullptr; }
+  // nullptr when usable, else the configuration error.
+  const char* error() const { return error_; }
   const dsp::Chain<Sample>& chain() const { return chain_; }
+  double pattern_max_rate_rad_s() const { return pattern_max_rate_rad_s_; }
 
  private:
+  const char* error_;
   dsp::Chain<Sample> chain_;
   double pattern_max_rate_rad_s_;
+  double last_pump_phase_rad_ = 0.0;
+  bool have_pump_phase_ = false;
 };
 
 }  // namespace hrg::fw

@@ -23,6 +23,10 @@ class EstimatorPort final : public Identifier {
   double drift_rad_s(double theta_a_rad, double ab_over_aa) const override {
     return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa);
   }
+  void add_control_sample(const ChainOutputs& s) override;
+  double control_drift_rad_s(double theta_a_rad) const override {
+    return est_.has_model() ? est_.d_phi_rad_s(theta_a_rad) : 0.0;
+  }
 
   const est::Estimator& estimator() const { return est_; }
   uint32_t windows_accepted() const { return windows_ok_; }
@@ -33,6 +37,9 @@ class EstimatorPort final : public Identifier {
   est::Estimator est_;
   EstimatorHealth health_{};
   bool dirty_ = false;  // a window was added since the last solve
+  // Control samples further apart than this (s) restart the D_Phi blocks.
+  static constexpr double kMaxControlGapS = 0.0015;
+  double last_control_t_s_ = -1.0;
   uint32_t windows_ok_ = 0;
   uint32_t windows_bad_ = 0;
   uint32_t solves_ok_ = 0;

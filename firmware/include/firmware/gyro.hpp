@@ -18,16 +18,17 @@
 namespace hrg::fw {
 
 struct GyroConfig {
-  double angular_gain = 0.554;       // K, from calibration (2 x Bryan factor)
-  double amplitude_set_v = 1.0;      // AGC set point for a_A at the pickoff
-  double amplitude_band = 0.05;      // |a_A - set| / set inside this counts as settled
-  double quadrature_band = 0.02;     // |a_B / a_A| inside this counts as settled
-  uint32_t self_test_frames = 20;    // power_up: clean frames before ring-up
-  uint32_t settle_frames = 200;      // lock: frames inside the bands before operate
-  uint32_t reacquire_frames = 10;    // recover: frames inside the bands before operate
-  uint32_t fault_hold_frames = 500;  // fault: clean frames before a retry
-  bool compensate_drift = true;      // add the drift model (after the window campaign)
-  bool identify = true;              // run the windows (off: use the model it has)
+  double angular_gain = 0.554;           // K, from calibration (2 x Bryan factor)
+  double amplitude_set_v = 1.0;          // AGC set point for a_A at the pickoff
+  double amplitude_band = 0.05;          // |a_A - set| / set inside this counts as settled
+  double quadrature_band = 0.02;         // |a_B / a_A| inside this counts as settled
+  uint32_t self_test_frames = 20;        // power_up: clean frames before ring-up
+  uint32_t settle_frames = 200;          // lock: frames inside the bands before operate
+  uint32_t reacquire_frames = 10;        // recover: frames inside the bands before operate
+  uint32_t fault_hold_frames = 500;      // fault: clean frames before a retry
+  bool compensate_drift = true;          // add the drift model (after the window campaign)
+  bool compensate_control_drift = true;  // and D_Phi with the excitation on (needs the model)
+  bool identify = true;                  // run the windows (off: use the model it has)
   WindowConfig windows{};
   MonitorConfig monitor{};
 };
@@ -45,7 +46,8 @@ struct GyroStatus {
   double out_angle_rad = 0.0;
   double out_raw_angle_rad = 0.0;
   double out_rate_rad_s = 0.0;
-  double drift_rad_s = 0.0;  // D used for the correction (Omega K units)
+  double drift_rad_s = 0.0;          // D used for the correction (Omega K units)
+  double control_drift_rad_s = 0.0;  // its control-loop part D_Phi
   bool out_valid = false;
   uint32_t adc_errors = 0;
   uint32_t adc_missed_blocks = 0;
@@ -61,6 +63,10 @@ class Gyro {
   static constexpr std::size_t kTaskCount = 7;
   // CAN command frames handled per command task run (the rest wait).
   static constexpr uint32_t kCommandsPerRun = 4;
+  // Command task runs spent bus-off before the CAN controller is restarted
+  // (0.1 s at 100 Hz, as can::CanLink: more than the 128 x 11 recessive bits
+  // the controller needs, and a faulty bus is not hammered).
+  static constexpr uint32_t kCanRestartRuns = 10;
   // Frames the output stays held after a commanded pattern move (longer than
   // the DAC and demodulator latency, a few frames).
   static constexpr uint32_t kPatternHoldFrames = 20;
@@ -93,6 +99,8 @@ class Gyro {
   // CAN telemetry as last encoded (the snapshot the frames were made from).
   const can::TelemetrySnapshot& telemetry() const { return snapshot_; }
   uint32_t can_tx_refused() const { return can_refused_; }
+  // CAN controller restarts made after bus-off.
+  uint32_t can_restarts() const { return can_restarts_; }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);
@@ -127,6 +135,8 @@ class Gyro {
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
   uint32_t can_refused_ = 0;
+  uint32_t can_off_runs_ = 0;
+  uint32_t can_restarts_ = 0;
   can::CommandValidator validator_{};
   uint32_t cmd_accepted_ = 0;
   uint32_t cmd_refused_ = 0;

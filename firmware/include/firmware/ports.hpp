@@ -30,7 +30,13 @@ struct ChainOutputs {
   double f_ref_hz = 0.0;                                  // NCO (reference) frequency
   double pump_v = 0.0;                                    // pump amplitude being output
   double quad_effort = 0.0;                               // quadrature forcer command, -1..1
-  bool locked = false;                                    // PLL lock detector
+  // Control-loop drift inputs (seed sections 6-7): the pump phase error
+  // eps = pi/2 - 2 (phi_V - phi_A) and the quadrature forcers' commanded
+  // action, the part on a_B' (sin) and the part on the angle (cos), V/s.
+  double pump_phase_error_rad = 0.0;
+  double quad_sin_v_s = 0.0;
+  double quad_cos_v_s = 0.0;
+  bool locked = false;  // PLL lock detector
 };
 
 // The DSP chain as the firmware sees it: once per ADC block, ADC block in, DAC
@@ -67,6 +73,13 @@ class Identifier {
   // Modelled drift D_nu + D_w (rad/s, Omega K units) at the current pattern
   // angle and quadrature ratio (seed eq. 22); 0 while nothing is identified.
   virtual double drift_rad_s(double theta_a_rad, double ab_over_aa) const = 0;
+  // Control-loop drift D_Phi (seed sections 6-7, eq. 23): fed with the
+  // excitation on, added to the output only with the excitation on.
+  virtual void add_control_sample(const ChainOutputs& s) { (void)s; }
+  virtual double control_drift_rad_s(double theta_a_rad) const {
+    (void)theta_a_rad;
+    return 0.0;
+  }
 };
 
 }  // namespace hrg::fw

@@ -156,14 +156,23 @@ JobConfig static_base_job(double duration_s) {
 }
 
 void derive_firmware_config(JobConfig& j) {
+  // The chain learns the converters from the simulated board's configuration
+  // (ADC full scale 2.5 V there, 2.0 V in the chain's defaults).
+  fw::ConverterInfo conv;
+  conv.sample_rate_hz = j.sim.adc.sample_rate_hz;
+  conv.block_frames = j.sim.adc.block_frames;
+  conv.adc_full_scale_v = j.sim.adc.full_scale_v;
+  conv.dac_full_scale_v = j.sim.dac.full_scale_v;
+  conv.dac_latency_samples = j.sim.dac.latency_samples;
+  j.chain = fw::chain_config_for(conv, j.chain);
   dsp::ChainConfig& c = j.chain;
-  c.sample_rate_hz = j.sim.adc.sample_rate_hz;
-  c.block_frames = j.sim.adc.block_frames;
-  c.adc_full_scale_v = j.sim.adc.full_scale_v;
-  c.dac_full_scale_v = j.sim.dac.full_scale_v;
-  c.dac_lead_frames = c.block_frames + j.sim.dac.latency_samples + 0.5;
   c.amplitude_setpoint_v = j.gyro.amplitude_set_v;
   j.estimator.angular_gain = j.gyro.angular_gain;
+  // The pump's gap part of D_Phi is used only once the pattern angles seen
+  // with the excitation on make its 3x3 fit well conditioned: an early fit
+  // from a few nearby angles adds more than it removes (default run: ADB
+  // 2.5 deg/h at the estimator's default 1e3, 0.15 deg/h at 10).
+  j.estimator.pump.max_kappa_2 = 10.0;
   j.gyro.monitor.amplitude_set_v = j.gyro.amplitude_set_v;
 }
 
@@ -193,6 +202,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim
   row.a_a_v = st.chain.a_a_v;
   row.a_b_v = st.chain.a_b_v;
   row.drift_model_dph = st.drift_rad_s / job.gyro.angular_gain * kRadSToDph;
+  row.drift_control_dph = st.control_drift_rad_s / job.gyro.angular_gain * kRadSToDph;
   const double q = ts.a_a_v > 0 ? ts.a_b_v / ts.a_a_v : 0.0;
   row.drift_true_dph = true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) /
                        job.gyro.angular_gain * kRadSToDph;
@@ -229,6 +239,8 @@ void analyse(JobResult& r, const JobConfig& job) {
   std::size_t n = 0;
   const double dt_h = 1.0 / job.telemetry_hz / 3600.0;
   double model_deg = 0, bound_deg = 0, raw_err = 0, out_err = 0;
+  double control_sum = 0;
+  std::size_t control_n = 0;
   const Row* prev = nullptr;
   for (Row& row : r.rows) {
     if (row.out_valid && prev != nullptr && prev->out_valid) {
@@ -240,6 +252,10 @@ void analyse(JobResult& r, const JobConfig& job) {
     row.out_error_deg = out_err;
     prev = &row;
     if (!row.out_valid) continue;
+    if (row.t_s >= r.t_operate_s) {
+      control_sum += row.drift_control_dph;
+      ++control_n;
+    }
     model_deg -= row.drift_true_dph * dt_h;
     bound_deg += std::fabs(row.drift_true_dph) * dt_h;
     if (row.t_s < r.t_operate_s) continue;
@@ -248,6 +264,7 @@ void analyse(JobResult& r, const JobConfig& job) {
     r.tracking_max_deg = std::max(r.tracking_max_deg, std::fabs(out_err));
   }
   r.tracking_rms_deg = n ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
+  r.control_drift_mean_dph = control_n ? control_sum / static_cast<double>(control_n) : 0.0;
   r.model_error_end_deg = model_deg;
   r.drift_bound_deg = bound_deg;
   r.raw_error_end_deg = raw_err;
@@ -316,10 +333,11 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   JobResult r;
   const bool progress = opt.progress;
   const std::string& can_log = opt.can_log;
-  if (const char* err = dsp::check_chain_config(job.chain)) throw std::invalid_argument(err);
+  fw::DspChainPort chain(job.chain);
+  if (const char* err = chain.error())
+    throw std::invalid_argument(std::string("signal chain configuration: ") + err);
   sim::SimTarget& target = sim::target();
   target.configure(job.sim);
-  fw::DspChainPort chain(job.chain);
   fw::EstimatorPort ident(job.estimator);
   // Lockstep: the board's simulated clock paces (it returns at once) and a
   // host clock times the tasks. Real time: CLOCK_MONOTONIC does both, with
@@ -370,6 +388,10 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
         case FaultEvent::Kind::adc_saturated: target.set_adc_saturated(e.channel, e.on); break;
         case FaultEvent::Kind::dac_dead: target.set_dac_dead(e.channel, e.on); break;
         case FaultEvent::Kind::fault_input: target.set_fault_input(e.on); break;
+        case FaultEvent::Kind::can_bus_off:
+          target.can().force_bus_off();
+          r.t_can_back_s = -1.0;
+          break;
       }
     }
     gyro->run_frame();
@@ -385,9 +407,14 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       last_mode = st.mode;
     }
     r.faults_seen = static_cast<uint16_t>(r.faults_seen | st.faults);
+    if (r.t_converged_s < 0 && gyro->scheduler().campaign_done()) r.t_converged_s = st.chain.t_s;
     if (st.mode == fw::Mode::operate && !r.reached_operate) {
       r.reached_operate = true;
       r.t_operate_s = st.chain.t_s;
+    }
+    if (r.t_can_back_s < 0 && !target.can().sent().empty() &&
+        target.can().counters().bus_off_events > 0) {
+      r.t_can_back_s = st.chain.t_s;
     }
     if (log) {
       auto& bus = target.can();
@@ -427,6 +454,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   r.sim_share =
       r.wall_s > 0 ? static_cast<double>(gyro->status().adc_wait_ns) * 1e-9 / r.wall_s : 0.0;
   r.final_mode = gyro->status().mode;
+  r.can_bus_off_events = target.can().counters().bus_off_events;
+  r.can_restarts = gyro->can_restarts();
   r.excitation_off_fraction = gyro->scheduler().excitation_off_fraction();
   r.windows = gyro->scheduler().windows();
   r.windows_accepted = ident.windows_accepted();
@@ -434,6 +463,19 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   r.identification = ident.identification();
   r.truth = true_parameters(job.sim.resonator);
   r.condition = ident.health().condition;
+  // Per-sample amplitude noise at the control rate: the pickoff noise (white,
+  // sigma per ADC sample) mixed by 2 cos and low-passed to one sample per
+  // block has the low-frequency density of a white sequence of variance
+  // 2 sigma^2 / L at the block rate; a_A and a_B are unit-norm projections of
+  // the x and y quadratures.
+  const double adc_sigma_v =
+      std::sqrt(0.5 * (job.sim.adc.noise_v_rms[0] * job.sim.adc.noise_v_rms[0] +
+                       job.sim.adc.noise_v_rms[1] * job.sim.adc.noise_v_rms[1]));
+  r.noise_sigma_v = adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.chain.block_frames));
+  const est::ParamMatrix crb = ident.estimator().cramer_rao_bound(r.noise_sigma_v);
+  for (int i = 0; i < est::kParams; ++i) {
+    r.crb_sigma[static_cast<std::size_t>(i)] = crb(i, i) > 0.0 ? std::sqrt(crb(i, i)) : 0.0;
+  }
   r.coverage = ident.health().coverage;
   summarise_executive(r, *gyro);
   if (log) log->flush();

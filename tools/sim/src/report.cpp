@@ -88,6 +88,7 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   bias_json(w, "compensated", r.fit_comp);
   bias_json(w, "model", r.fit_model);
   w.integer("parked_angles", static_cast<long long>(r.parks.size()));
+  w.number("control_drift_mean_dph", r.control_drift_mean_dph);
   w.begin_array("parks");
   for (const auto& p : r.parks) {
     w.begin_object();
@@ -107,10 +108,13 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.integer("windows", r.windows);
   w.integer("windows_accepted", r.windows_accepted);
   w.boolean("campaign_done", r.campaign_done);
+  w.number("t_converged_s", r.t_converged_s);
+  w.number("noise_sigma_v", r.noise_sigma_v);
   for (int i = 0; i < 5; ++i) {
     w.begin_object(kParamNames[i]);
     w.number("estimate", r.identification.p[i]);
     w.number("sigma", r.identification.sigma[i]);
+    w.number("crb_sigma", r.crb_sigma[static_cast<std::size_t>(i)]);
     w.number("truth", r.truth[static_cast<std::size_t>(i)]);
     w.end_object();
   }
@@ -280,14 +284,18 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
                                   adev_min * kRadSToDph, tau_min, r.allan_span_s)});
   run.print(out);
 
-  TextTable id("identification (estimate +- sigma, truth)");
+  TextTable id(fmt("identification (estimate +- sigma, Cramer-Rao bound at %.2g V, truth)",
+                   r.noise_sigma_v));
   for (int i = 0; i < 5; ++i) {
     id.row({kParamNames[i], fmt("%+.4e", r.identification.p[i]),
             fmt("+- %.1e", r.identification.sigma[i]),
+            fmt("CRB %.1e", r.crb_sigma[static_cast<std::size_t>(i)]),
             fmt("%+.4e", r.truth[static_cast<std::size_t>(i)])});
   }
   id.row({"condition", fmt("%.1f", r.condition), fmt("coverage %.2f", r.coverage),
-          r.identification.valid ? "accepted" : "not accepted"});
+          r.identification.valid ? "accepted" : "not accepted",
+          r.t_converged_s >= 0 ? fmt("converged at %.1f s", r.t_converged_s)
+                               : std::string("campaign not done")});
   id.print(out);
 
   TextTable bias("angle-dependent bias, b + A sin4th + B cos4th (deg/h, input axis)");
@@ -300,6 +308,7 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   add("compensated", r.fit_comp);
   add("drift model (truth)", r.fit_model);
   bias.row({"parked angles", fmt("%zu", r.parks.size())});
+  bias.row({"control-loop drift", fmt("%+.3f", r.control_drift_mean_dph), "(mean D_Phi/K added)"});
   bias.print(out);
 
   TextTable ex(r.real_time ? "executive (real time: " + r.realtime_setup + ")"

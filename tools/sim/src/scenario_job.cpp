@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "sim_tools/scenario_job.hpp"
 
+#include <stdexcept>
+
+#include "dsp/chain.hpp"
 #include "sim_target/scenario.hpp"
 
 namespace hrg::simtools {
@@ -33,6 +36,10 @@ JobConfig job_from_scenario(const std::string& path, double duration_s, int bias
   job.chain.q_factor = sc.resonator.q;
   job.chain.pump_gain_per_s2_v2 = sc.electrodes.pump_gain_per_s2_v2;
   job.chain.forcer_gain_per_s2 = sc.electrodes.forcer_gain_per_s2;
+  // The PLL range above (+-10 Hz about the resonance) and the converters
+  // must still make a usable chain (e.g. the NCO's periodicity rule).
+  if (const char* err = dsp::check_chain_config(job.chain))
+    throw std::invalid_argument("scenario " + path + ": signal chain configuration: " + err);
   return job;
 }
 

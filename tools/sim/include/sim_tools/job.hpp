@@ -23,7 +23,7 @@ struct Park {
 
 // A fault injected through the simulated target's back door at time t_s.
 struct FaultEvent {
-  enum class Kind : uint8_t { adc_stuck, adc_saturated, dac_dead, fault_input };
+  enum class Kind : uint8_t { adc_stuck, adc_saturated, dac_dead, fault_input, can_bus_off };
   double t_s = 0.0;
   Kind kind = Kind::adc_stuck;
   std::size_t channel = 0;  // ADC 0 = x, 1 = y; DAC 0 = pump, 1 = fx, 2 = fy
@@ -73,6 +73,7 @@ struct Row {
   int mode;
   double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
   double a_a_v, a_b_v, drift_model_dph, drift_true_dph;
+  double drift_control_dph;  // the control-loop part of drift_model_dph
   int out_valid;
   int pattern_cmd;  // the pattern is being moved on purpose
   // Output minus truth, accumulated only between consecutive rows with a
@@ -120,6 +121,13 @@ struct JobResult {
   std::array<double, 5> truth{};
   double condition = 0.0;
   double coverage = 0.0;
+  // Cramer-Rao bound (standard deviation) of each parameter for the windows
+  // taken, at the per-sample amplitude noise noise_sigma_v (from the ADC
+  // noise through the demodulator).
+  std::array<double, 5> crb_sigma{};
+  double noise_sigma_v = 0.0;
+  double t_converged_s = -1.0;          // the window campaign ended (model applied)
+  double control_drift_mean_dph = 0.0;  // mean D_Phi/K added over the valid output
   std::vector<Row> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
@@ -134,6 +142,9 @@ struct JobResult {
   std::vector<TaskFigures> tasks;
   fw::FrameStats frames{};
   uint64_t can_frames = 0;
+  uint32_t can_bus_off_events = 0;  // the simulated controller's count
+  uint32_t can_restarts = 0;        // restarts the firmware made after bus-off
+  double t_can_back_s = -1.0;       // first frame on the bus after the last bus-off
   uint32_t mode_changes = 0;
   double t_first_fault_s = -1.0;   // first frame in fault or safe
   double t_back_operate_s = -1.0;  // first return to operate after that
