@@ -22,6 +22,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
+// Runs at least this long get an identification phase of their own, until
+// kLongIdentS of simulated time.
+constexpr double kLongRunS = 1800.0;
+constexpr double kLongIdentS = 800.0;
 
 // Rate-table schedule, built as a piecewise-linear profile of the case rate.
 struct Schedule {
@@ -85,7 +89,20 @@ JobConfig default_job(double duration_s, int bias_angles) {
   sch.hold(45.0);
   const double sweep_rate = 10.0 * kDeg;  // case rate, pattern at about 2.8 deg/s
   // Two full 4 theta turns of the pattern: 180 deg of theta.
-  sch.turn(2.0 * (kPi / 2.0) * 2.0 / k, sweep_rate, 1.0);
+  const double sweep_case_rad = 2.0 * (kPi / 2.0) * 2.0 / k;
+  sch.turn(sweep_case_rad, sweep_rate, 1.0);
+  // Runs of an hour or more: the identification gets its own phase of
+  // turning back and forth with long windows (see the window settings below)
+  // before the parks, so that the model applied during the bias test has
+  // converged (the decay-rate information of a window grows as T^3).
+  const bool long_run = duration_s >= kLongRunS;
+  if (long_run) {
+    double sign = -1.0;
+    while (sch.t < kLongIdentS) {
+      sch.turn(sign * sweep_case_rad, sweep_rate, 1.0);
+      sign = -sign;
+    }
+  }
   sch.hold(2.0);
   j.sweep_end_s = sch.t;
 
@@ -133,6 +150,17 @@ JobConfig default_job(double duration_s, int bias_angles) {
   // The rate table turns the pattern here; commanded rotation is for a base
   // that never turns (the output is held while the pattern is moved).
   g.windows.rotate_on_static_base = false;
+  if (long_run) {
+    // 4 windows of 5 s per 4 theta bin while the table turns (64 windows,
+    // 320 s: 8.9 % of an hour), 10 s apart so the AGC is back at the set
+    // point between them; each carries 125 times the decay information of a
+    // 1 s window. The campaign ends only when every bin has its 4.
+    g.windows.length_frames = 5000;
+    g.windows.period_frames = 10000;
+    g.windows.max_wait_frames = 20000;
+    g.windows.windows_per_bin = 4;
+    g.windows.min_windows_per_bin = 4;
+  }
   derive_firmware_config(j);
   return j;
 }
