@@ -22,6 +22,17 @@ dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig ba
   return base;
 }
 
+dsp::ChainConfig chain_config_for(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
+                                  double dac_latency_samples, dsp::ChainConfig base) {
+  ConverterInfo conv;
+  conv.sample_rate_hz = static_cast<double>(adc.sample_rate_hz);
+  conv.block_frames = adc.block_frames;
+  conv.adc_full_scale_v = adc.full_scale_v;
+  conv.dac_full_scale_v = dac.full_scale_v;
+  conv.dac_latency_samples = dac_latency_samples;
+  return chain_config_for(conv, base);
+}
+
 double max_pattern_rate_rad_s(const dsp::ChainConfig& cfg, double margin) {
   const double w_rad_s = 2.0 * kPi * cfg.f_center_hz;
   const double a_v = std::max(cfg.amplitude_setpoint_v, cfg.min_amplitude_v);

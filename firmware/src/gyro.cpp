@@ -22,8 +22,10 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
   const hal::ConverterInfo dac = board.dac.info();
   // The buffers are sized at compile time; a board with another layout is
   // refused (the firmware stays in power_up with drives off).
+  // An unusable chain configuration (chain_error() names it) is refused the
+  // same way.
   board_ok_ = adc.block_frames == kBlockFrames && dac.block_frames == kBlockFrames &&
-              adc.sample_rate_hz == kAdcRateHz;
+              adc.sample_rate_hz == kAdcRateHz && chain.config_error() == nullptr;
   block_ns_ = 1'000'000'000ull / kBaseRateHz;
   (void)board_.excitation_enable.write(false);
 }

@@ -6,7 +6,10 @@
 #include <cstdint>
 #include <numbers>
 
+#include "fakes/fake_board.hpp"
+#include "fakes/fake_chain.hpp"
 #include "firmware/dsp_chain_port.hpp"
+#include "firmware/gyro.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -114,4 +117,30 @@ TEST(DspChainPort, ThePatternRateIsClampedToWhatTheForcersCanDo) {
   DOUBLES_EQUAL(1e-3, slow.pattern_max_rate_rad_s(), 0.0);
   DspChainPort derived(c);
   DOUBLES_EQUAL(0.8 * full, derived.pattern_max_rate_rad_s(), 1e-12);
+}
+
+TEST(DspChainPort, TheHalConverterInfoGivesTheSameConfiguration) {
+  const hrg::hal::ConverterInfo adc{100000, 100, 2.5};
+  const hrg::hal::ConverterInfo dac{100000, 100, 10.0};
+  const ChainConfig c = hrg::fw::chain_config_for(adc, dac, 2.0);
+  DOUBLES_EQUAL(2.5, c.adc_full_scale_v, 0.0);
+  DOUBLES_EQUAL(10.0, c.dac_full_scale_v, 0.0);
+  DOUBLES_EQUAL(102.5, c.dac_lead_frames, 0.0);
+  LONGS_EQUAL(100, c.block_frames);
+}
+
+TEST(DspChainPort, TheGyroRefusesAnUnusableChainAndKeepsTheDrivesOff) {
+  ChainConfig c;
+  c.pump_max_v = -1.0;
+  DspChainPort port(c);
+  hrg::fakes::FakeBoard b;
+  hrg::fakes::FakeClock timer;
+  hrg::fakes::FakeIdentifier ident;
+  hrg::fw::Gyro g(b.board, port, ident, timer, hrg::fw::Pacing::lockstep, hrg::fw::GyroConfig{});
+  CHECK_FALSE(g.board_ok());
+  STRCMP_CONTAINS("pump_max_v", g.chain_error());
+  for (int i = 0; i < 100; ++i)
+    g.run_frame();
+  CHECK(hrg::fw::Mode::power_up == g.status().mode);
+  CHECK_FALSE(g.status().excitation_on);
 }

@@ -24,6 +24,10 @@ struct ConverterInfo {
 // block n acts one block later, plus half a frame of zero-order hold, plus
 // the DAC's pipeline.
 dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig base = {});
+// The same from the board's HAL converter info (the DAC pipeline, which the
+// HAL does not describe, from the board's data sheet).
+dsp::ChainConfig chain_config_for(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
+                                  double dac_latency_samples, dsp::ChainConfig base = {});
 
 // Fastest pattern turn the forcers can make at the set point (rad/s of
 // theta_A): theta_A' = g u_r / (4 w a_A) with u_r at forcer_max_v, less
@@ -49,6 +53,7 @@ class DspChainPort final : public SignalChain {
   bool usable() const { return error_ == nullptr; }
   // nullptr when usable, else the configuration error.
   const char* error() const { return error_; }
+  const char* config_error() const override { return error_; }
   const dsp::Chain<Sample>& chain() const { return chain_; }
   double pattern_max_rate_rad_s() const { return pattern_max_rate_rad_s_; }
 

@@ -96,6 +96,8 @@ class Gyro {
   const GyroConfig& config() const { return cfg_; }
   // False when the board's converters do not match the firmware's block layout.
   bool board_ok() const { return board_ok_; }
+  // nullptr, or why the signal chain's configuration is unusable.
+  const char* chain_error() const { return chain_.config_error(); }
   // CAN telemetry as last encoded (the snapshot the frames were made from).
   const can::TelemetrySnapshot& telemetry() const { return snapshot_; }
   uint32_t can_tx_refused() const { return can_refused_; }

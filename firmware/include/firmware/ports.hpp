@@ -48,6 +48,9 @@ class SignalChain {
   // to fill. Task context, once per base frame; must not allocate.
   virtual void process(std::span<const hal::sample_q31> adc, std::span<hal::sample_q31> dac,
                        const ChainCommands& cmd, ChainOutputs& out) = 0;
+  // nullptr when the chain's configuration is usable, else what is wrong
+  // (the firmware then keeps the drives off).
+  virtual const char* config_error() const { return nullptr; }
 };
 
 // Identified drift model and its uncertainty, p = (nu, dnu_C, dnu_S, dw_C, dw_S).
