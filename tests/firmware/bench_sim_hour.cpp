@@ -27,9 +27,9 @@ void run_benchmark() {
               100.0 * r.excitation_off_fraction, r.windows, r.windows_accepted);
   std::printf("  identification converged (window campaign done) at %.1f s\n", r.t_converged_s);
   std::printf("  angle-dependent bias (deg/h, input axis, %zu parked angles):\n", r.parks.size());
-  std::printf("    raw          ADB %8.3f  mean %+7.3f +- %.3f\n", r.fit_raw.amplitude(),
+  std::printf("    raw          ADB %8.3f  mean %+7.3f +- %.4f\n", r.fit_raw.amplitude(),
               r.fit_raw.b0, r.fit_raw.sigma_b0);
-  std::printf("    compensated  ADB %8.3f  mean %+7.3f +- %.3f   goal ADB <= 0.05\n",
+  std::printf("    compensated  ADB %8.3f  mean %+7.3f +- %.4f   goal ADB <= 0.05\n",
               r.fit_comp.amplitude(), r.fit_comp.b0, r.fit_comp.sigma_b0);
   std::printf("    control-loop drift added (mean D_Phi/K) %+.3f deg/h\n",
               r.control_drift_mean_dph);
