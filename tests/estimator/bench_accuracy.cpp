@@ -15,10 +15,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <random>
+#include <span>
 
 #include <Eigen/Dense>
 
 #include "averaged_runner.hpp"
+#include "sim_tools/analysis.hpp"
 
 using namespace hrg::est;
 using namespace hrg::est::test;
@@ -32,21 +34,12 @@ constexpr double kWindowS = 5.5;
 constexpr double kChunkS = 0.05;
 constexpr double kGoalDegH = 0.05;
 
-struct Fit {
-  double b, a, c, amplitude;
-};
+using hrg::simtools::BiasFit;
 
-// Least squares of y = b + A sin4th + B cos4th.
-Fit fit_adb(const double* th, const double* y, int n) {
-  Eigen::Matrix3d n3 = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d r = Eigen::Vector3d::Zero();
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d h(1.0, std::sin(4 * th[i]), std::cos(4 * th[i]));
-    n3 += h * h.transpose();
-    r += h * y[i];
-  }
-  const Eigen::Vector3d x = n3.ldlt().solve(r);
-  return {x(0), x(1), x(2), std::hypot(x(1), x(2))};
+// IEEE 1431 fit b + A sin4th + B cos4th over the parked angles (deg/h).
+template <std::size_t N>
+BiasFit fit_parked(const double (&th)[N], const double (&y)[N]) {
+  return hrg::simtools::fit_bias_4theta(std::span<const double>(th), std::span<const double>(y));
 }
 
 // Angle-dependent part of the model error, deg/h of input rate.
@@ -127,8 +120,8 @@ HourResult run_hour(uint64_t seed, bool verbose, double forgetting_time_s = 0.0)
     raw[k] = raw_rad_s * kRadSToDegH;
     comp[k] = (raw_rad_s + est.drift_rate_rad_s(th[k], 0.0) / K) * kRadSToDegH;
   }
-  const Fit fr = fit_adb(th, raw, kParked);
-  const Fit fc = fit_adb(th, comp, kParked);
+  const BiasFit fr = fit_parked(th, raw);
+  const BiasFit fc = fit_parked(th, comp);
   // The paper's other variants on the same normal equations.
   double comp_variant[4] = {0, 0, 0, 0};
   for (int v = 0; v < 4; ++v) {
@@ -138,11 +131,11 @@ HourResult run_hour(uint64_t seed, bool verbose, double forgetting_time_s = 0.0)
       cv[k] =
           comp[k] + (resonator_drift_rad_s(sv.p, th[k], 0.0) - est.drift_rate_rad_s(th[k], 0.0)) /
                         K * kRadSToDegH;
-    comp_variant[v] = sv.accepted() ? fit_adb(th, cv, kParked).amplitude : -1.0;
+    comp_variant[v] = sv.accepted() ? fit_parked(th, cv).amplitude() : -1.0;
   }
   const Solution& s = est.last_solution();
   const ParamMatrix crb = est.cramer_rao_bound(kQuadratureNoiseV);
-  const HourResult result{fr.amplitude, fc.amplitude, converged_at_s, self_converged_at_s};
+  const HourResult result{fr.amplitude(), fc.amplitude(), converged_at_s, self_converged_at_s};
   if (!verbose) return result;
 
   std::printf(
@@ -151,10 +144,10 @@ HourResult run_hour(uint64_t seed, bool verbose, double forgetting_time_s = 0.0)
       kQuadratureNoiseV);
   std::printf("  windows %d x %.1f s, excitation off %.1f %% of the time\n", windows, kWindowS,
               100.0 * off_time_s / kHourS);
-  std::printf("  raw ADB         b %+8.4f  A %+9.4f  B %+9.4f  |ADB| %9.4f deg/h\n", fr.b, fr.a,
-              fr.c, fr.amplitude);
+  std::printf("  raw ADB         b %+8.4f  A %+9.4f  B %+9.4f  |ADB| %9.4f deg/h\n", fr.b0,
+              fr.a_sin4, fr.b_cos4, fr.amplitude());
   std::printf("  compensated ADB b %+8.4f  A %+9.4f  B %+9.4f  |ADB| %9.4f deg/h (goal <= %.2f)\n",
-              fc.b, fc.a, fc.c, fc.amplitude, kGoalDegH);
+              fc.b0, fc.a_sin4, fc.b_cos4, fc.amplitude(), kGoalDegH);
   std::printf(
       "  compensated |ADB| by variant: joint %.4f, damping-only %.4f, split-only %.4f "
       "(no anisotropy model), alternating %.4f deg/h\n",
