@@ -118,3 +118,97 @@ TEST(AuditSimulated, StructureOutsideTheCatalogueIsUnexplained) {
   LONGS_EQUAL(0, r.findings.size());
   CHECK(!r.unexplained_note.empty());
 }
+
+namespace {
+
+bool names(const AuditResult& r, Effect e) {
+  for (const auto& f : r.findings)
+    if (f.effect == e) return true;
+  for (const auto& a : r.alternatives)
+    if (a.effect == e) return true;
+  return false;
+}
+
+double named_value(const AuditResult& r, Effect e) {
+  for (const auto& f : r.findings)
+    if (f.effect == e) return f.value;
+  for (const auto& a : r.alternatives)
+    if (a.effect == e) return a.value;
+  return 0.0;
+}
+
+// A ring-down campaign with a Duffing resonator, and the same campaign whose
+// temperature reading follows the squared amplitude (self-heating of the
+// drive: T = T0 + k a^2). With that reading, Duffing (df = c a^2) and the
+// thermal frequency (df = f alpha (T - T0) = f alpha k a^2) predict the same
+// frequency in every block, so no recording of this design can tell them apart.
+struct Confounded {
+  hrg::recording::Recording independent;  // temperature swings on its own
+  hrg::recording::Recording coupled;      // temperature follows a^2
+  double c_hz_per_v2 = 0.0;
+};
+
+Confounded duffing_campaign() {
+  auto s = hrg::audit::bench::random_scenario(hrg::audit::bench::Design::ringdown, 300.0, 11);
+  // The Duffing coefficient at 10x its detection threshold in this design.
+  const AuditResult null = hrg::audit::run_audit(hrg::audit::bench::simulate(s));
+  double threshold = 0.0;
+  for (const auto& c : null.candidates)
+    if (c.effect == Effect::duffing_stiffness) threshold = c.threshold;
+  CHECK(threshold > 0.0);
+  Confounded out;
+  out.c_hz_per_v2 = -10.0 * threshold;
+  s.effects.duffing_stiffness = {true, out.c_hz_per_v2};
+  out.independent = hrg::audit::bench::simulate(s);
+  // The noise-free twin gives the true a^2 (same draws, zero noise).
+  auto clean_s = s;
+  clean_s.noise_v = 0.0;
+  const auto clean = hrg::audit::bench::simulate(clean_s);
+  out.coupled = out.independent;
+  const double k_c_per_v2 = 2.0;
+  const double t0_c = s.temp_mean_c;
+  const auto& cx = clean.column("cx_v");
+  const auto& sx = clean.column("sx_v");
+  const auto& cy = clean.column("cy_v");
+  const auto& sy = clean.column("sy_v");
+  auto& temp = out.coupled.column("temp_c");
+  for (std::size_t i = 0; i < temp.size(); ++i) {
+    const double a2 = cx[i] * cx[i] + sx[i] * sx[i] + cy[i] * cy[i] + sy[i] * sy[i];
+    temp[i] = t0_c + k_c_per_v2 * a2;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(AuditSimulated, AmplitudeAndTemperatureMovingTogetherIsAmbiguous) {
+  // GIVEN a Duffing resonator whose temperature reading follows a^2
+  const Confounded c = duffing_campaign();
+  // WHEN audited
+  const AuditResult r = hrg::audit::run_audit(c.coupled);
+  // THEN it does not guess: both candidates are named, and so is the
+  // experiment that separates them (amplitude at constant temperature).
+  STRCMP_EQUAL("ambiguous", r.verdict.c_str());
+  CHECK(names(r, Effect::duffing_stiffness));
+  CHECK(names(r, Effect::thermal_frequency));
+  // Whichever comes first, the Duffing reading of the data is the true one.
+  DOUBLES_EQUAL(c.c_hz_per_v2, named_value(r, Effect::duffing_stiffness),
+                0.2 * std::abs(c.c_hz_per_v2));
+  const std::string& x = r.ambiguity_experiment;
+  CHECK(x.find("duffing_stiffness") != std::string::npos);
+  CHECK(x.find("thermal_frequency") != std::string::npos);
+  CHECK(x.find("amplitude") != std::string::npos);
+  CHECK(x.find("temperature") != std::string::npos);
+}
+
+TEST(AuditSimulated, AmplitudeMovingAtItsOwnTemperatureIsDuffing) {
+  // GIVEN the same Duffing campaign with the temperature on its own slow swing
+  // (the amplitude varies at a temperature that does not follow it)
+  const Confounded c = duffing_campaign();
+  const AuditResult r = hrg::audit::run_audit(c.independent);
+  // THEN the finding is Duffing with its coefficient within 20 %
+  STRCMP_EQUAL("explained", r.verdict.c_str());
+  CHECK(!r.findings.empty());
+  CHECK(r.findings.front().effect == Effect::duffing_stiffness);
+  DOUBLES_EQUAL(c.c_hz_per_v2, r.findings.front().value, 0.2 * std::abs(c.c_hz_per_v2));
+}
