@@ -16,6 +16,7 @@ constexpr double kPi = std::numbers::pi;
 constexpr std::size_t kMinFreeSamples = 20;
 constexpr std::size_t kMinForcedSamples = 8;
 constexpr std::size_t kEdgeRows = 10;
+constexpr std::size_t kSlopeRows = 40;
 
 struct Run {
   std::size_t first = 0, last = 0;  // inclusive rows
@@ -266,6 +267,9 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
         v += pump ? std::abs((*pump)[row]) / static_cast<double>(m) : 1.0 / static_cast<double>(m);
       }
       e.pump_v = v;
+      const std::size_t run_rows = fr.last - fr.first + 1;
+      for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j)
+        e.slope_rows.push_back(at_start ? fr.last - j : fr.first + j);
       if (m >= 4) d.edges.push_back(e);
     };
     if (ri > 0 && runs[ri - 1].exc && runs[ri - 1].last + 1 == r.first && !gap_before[r.first]) {

@@ -54,6 +54,11 @@ struct Edge {
   std::size_t free_segment = 0;          // index into free segments
   bool at_start = false;                 // edge at the start of the free segment (exc 1 -> 0)
   std::vector<std::size_t> forced_rows;  // nearest excitation rows, nearest first
+  // Excitation rows beyond forced_rows, nearest first: the force-driven slope
+  // at the edge is measured on them so that its noise is independent of the
+  // jump's (a direction taken from the jump's own rows bends the jump's noise
+  // towards it and biases the sign-free statistic).
+  std::vector<std::size_t> slope_rows;
   double pump_v = 0.0;
 };
 

@@ -45,7 +45,9 @@ struct EdgeJump {
 EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   EdgeJump ej;
   double phase = 0.0;
-  const auto pred = predict_rows(d, p, e.free_segment, e.forced_rows, &phase);
+  std::vector<std::size_t> rows = e.forced_rows;
+  rows.insert(rows.end(), e.slope_rows.begin(), e.slope_rows.end());
+  const auto pred = predict_rows(d, p, e.free_segment, rows, &phase);
   const std::size_t near = e.forced_rows.front();
   const std::size_t free_row = e.at_start ? near + 1 : near - 1;
   const double t_e = 0.5 * (d.t_s[near] + d.t_s[free_row]);
@@ -65,8 +67,30 @@ EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   const Eigen::Matrix<cplx, 3, 2> coef = si.cast<cplx>() * b;
   const Vec4 r0 = real4({coef(0, 0), coef(0, 1)});
   const Vec4 r1 = real4({coef(1, 0), coef(1, 1)});
+  // The slope direction from the rows beyond (straight line; independent
+  // noise), or from the jump's own rows when the run is too short.
+  Vec4 dir = r1;
+  const std::size_t m0 = e.forced_rows.size();
+  if (e.slope_rows.size() >= 8) {
+    double st = 0.0, stt = 0.0, n = 0.0;
+    std::array<cplx, 2> sz{}, stz{};
+    for (std::size_t j = m0; j < rows.size(); ++j) {
+      const double tau = (d.t_s[rows[j]] - t_e) / dt;
+      const std::array<cplx, 2> r{d.x[rows[j]] - pred[j][0], d.y[rows[j]] - pred[j][1]};
+      n += 1.0, st += tau, stt += tau * tau;
+      for (std::size_t k = 0; k < 2; ++k)
+        sz[k] += r[k], stz[k] += tau * r[k];
+    }
+    const double den = n * stt - st * st;
+    if (den > 0.0) {
+      std::array<cplx, 2> slope{};
+      for (std::size_t k = 0; k < 2; ++k)
+        slope[k] = (n * stz[k] - st * sz[k]) / den;
+      dir = real4(slope);
+    }
+  }
   ej.proj = Eigen::Matrix4d::Identity();
-  if (r1.squaredNorm() > 0.0) ej.proj -= r1 * r1.transpose() / r1.squaredNorm();
+  if (dir.squaredNorm() > 0.0) ej.proj -= dir * dir.transpose() / dir.squaredNorm();
   ej.j = ej.proj * r0;
   ej.var = si(0, 0) * d.noise_v * d.noise_v;
   ej.phasor = std::polar(1.0, phase);
