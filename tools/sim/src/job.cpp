@@ -207,19 +207,25 @@ void derive_firmware_config(JobConfig& j) {
 namespace {
 
 void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim::TrueState& ts,
-                double true_angle0, double out0, double raw0) {
+                double ref_offset_rad, double true_angle0, double out0, double raw0) {
   const fw::GyroStatus& st = g.status();
   Row row{};
   row.t_s = st.chain.t_s;
-  row.cx_v = st.chain.cx_v;
-  row.sx_v = st.chain.sx_v;
-  row.cy_v = st.chain.cy_v;
-  row.sy_v = st.chain.sy_v;
+  // The chain demodulates against its NCO, whose phase the PLL moves every
+  // block. The recording's cx..sy are against the fixed metadata reference
+  // (ph = 2 pi f_ref t): x = Re((cx - i sx) e^(i ph_nco)) = Re((cx' - i sx')
+  // e^(i ph)) with cx' - i sx' = (cx - i sx) e^(i (ph_nco - ph)).
+  const double c = std::cos(ref_offset_rad);
+  const double s = std::sin(ref_offset_rad);
+  row.cx_v = st.chain.cx_v * c + st.chain.sx_v * s;
+  row.sx_v = st.chain.sx_v * c - st.chain.cx_v * s;
+  row.cy_v = st.chain.cy_v * c + st.chain.sy_v * s;
+  row.sy_v = st.chain.sy_v * c - st.chain.cy_v * s;
   row.exc = st.excitation_on ? 1 : 0;
   row.pump_v = st.chain.pump_v;
   row.temp_c = ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;
-  row.f_ref_hz = st.chain.f_ref_hz;
+  row.pll_hz = st.chain.f_ref_hz;
   row.quad_v = st.chain.a_b_v;
   row.mode = static_cast<int>(st.mode);
   row.theta_deg = st.theta_unwrapped_rad / kDeg;
@@ -407,6 +413,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   const std::clock_t cpu0 = std::clock();
   std::size_t next_fault = 0;
   fw::Mode last_mode = fw::Mode::power_up;
+  // NCO phase minus 2 pi f_ref t at the end of this block and the two before.
+  double ref_offset_hist[3] = {0.0, 0.0, 0.0};
   for (uint64_t k = 0; k < frames; ++k) {
     while (next_fault < job.faults.size() &&
            job.faults[next_fault].t_s <= static_cast<double>(k) / fw::kBaseRateHz) {
@@ -424,6 +432,15 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     }
     gyro->run_frame();
     const fw::GyroStatus& st = gyro->status();
+    {
+      // NCO phase at the first sample after this block (time t_s) against the
+      // fixed reference 2 pi f_ref t.
+      const double nco_cycles = static_cast<double>(chain.chain().nco_phase()) * 0x1p-32;
+      const double ref_cycles = std::fmod(job.chain.f_center_hz * st.chain.t_s, 1.0);
+      ref_offset_hist[2] = ref_offset_hist[1];
+      ref_offset_hist[1] = ref_offset_hist[0];
+      ref_offset_hist[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
+    }
     if (st.mode != last_mode) {
       ++r.mode_changes;
       if ((st.mode == fw::Mode::fault || st.mode == fw::Mode::safe) && r.t_first_fault_s < 0) {
@@ -464,7 +481,13 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       raw0 = st.out_raw_angle_rad;
       have_ref = true;
     }
-    record_row(r, job, *gyro, ts, true0, out0, raw0);
+    // The decimating filter's output is centred 1.5 L - 1 samples before the
+    // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
+    // NCO offsets one and two blocks back.
+    const double ref_offset_rad =
+        ref_offset_hist[1] +
+        0.5 * std::remainder(ref_offset_hist[2] - ref_offset_hist[1], 2.0 * kPi);
+    record_row(r, job, *gyro, ts, ref_offset_rad, true0, out0, raw0);
     if (progress && k % 1000 == 0) {
       bar.update(static_cast<double>(k),
                  fmt("t=%.0f s %s", st.chain.t_s, fw::to_string(st.mode)).c_str());

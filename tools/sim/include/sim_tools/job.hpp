@@ -69,7 +69,9 @@ void derive_firmware_config(JobConfig& job);
 struct Row {
   double t_s, cx_v, sx_v, cy_v, sy_v;
   int exc;
-  double pump_v, temp_c, rate_dps, f_ref_hz, quad_v;
+  double pump_v, temp_c, rate_dps;
+  double pll_hz;  // the PLL (NCO) frequency; cx..sy are against the fixed f_ref_hz
+  double quad_v;
   int mode;
   double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
   double a_a_v, a_b_v, drift_model_dph, drift_true_dph;
