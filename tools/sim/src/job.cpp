@@ -207,7 +207,8 @@ void derive_firmware_config(JobConfig& j) {
 namespace {
 
 void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim::TrueState& ts,
-                double ref_offset_rad, double true_angle0, double out0, double raw0) {
+                double ref_offset_rad, bool drive_free, double true_angle0, double out0,
+                double raw0) {
   const fw::GyroStatus& st = g.status();
   Row row{};
   row.t_s = st.chain.t_s;
@@ -221,7 +222,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim
   row.sx_v = st.chain.sx_v * c - st.chain.cx_v * s;
   row.cy_v = st.chain.cy_v * c + st.chain.sy_v * s;
   row.sy_v = st.chain.sy_v * c - st.chain.cy_v * s;
-  row.exc = st.excitation_on ? 1 : 0;
+  row.exc = drive_free ? 0 : 1;
   row.pump_v = st.chain.pump_v;
   row.temp_c = ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;
@@ -415,6 +416,16 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   fw::Mode last_mode = fw::Mode::power_up;
   // NCO phase minus 2 pi f_ref t at the end of this block and the two before.
   double ref_offset_hist[3] = {0.0, 0.0, 0.0};
+  // A row is free of any drive once the last driven DAC word (played
+  // dac_lead_frames + the DAC's pipeline latency after its block) lies before
+  // the 3 L - 2 samples the demodulator averages: exc = 0 only from then on.
+  const double block_frames = static_cast<double>(job.chain.block_frames);
+  const auto drive_free_blocks =
+      static_cast<uint64_t>(1.0 + std::ceil((job.chain.dac_lead_frames +
+                                             static_cast<double>(job.sim.dac.latency_samples) +
+                                             2.0 * block_frames - 2.0) /
+                                            block_frames));
+  uint64_t off_blocks = drive_free_blocks;  // blocks since the excitation was last on
   for (uint64_t k = 0; k < frames; ++k) {
     while (next_fault < job.faults.size() &&
            job.faults[next_fault].t_s <= static_cast<double>(k) / fw::kBaseRateHz) {
@@ -432,6 +443,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     }
     gyro->run_frame();
     const fw::GyroStatus& st = gyro->status();
+    off_blocks = st.excitation_on ? 0 : off_blocks + 1;
     {
       // NCO phase at the first sample after this block (time t_s) against the
       // fixed reference 2 pi f_ref t.
@@ -487,7 +499,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     const double ref_offset_rad =
         ref_offset_hist[1] +
         0.5 * std::remainder(ref_offset_hist[2] - ref_offset_hist[1], 2.0 * kPi);
-    record_row(r, job, *gyro, ts, ref_offset_rad, true0, out0, raw0);
+    record_row(r, job, *gyro, ts, ref_offset_rad, off_blocks >= drive_free_blocks, true0, out0,
+               raw0);
     if (progress && k % 1000 == 0) {
       bar.update(static_cast<double>(k),
                  fmt("t=%.0f s %s", st.chain.t_s, fw::to_string(st.mode)).c_str());
