@@ -264,9 +264,10 @@ TEST(InjectedFaults, AStuckAdcChannelIsAFaultAndTheGyroRecoversAfterTheHoldTime)
   CHECK(r.t_back_operate_s > 10.5 + 0.5);
   CHECK(r.t_back_operate_s < 10.5 + 0.5 + 2.0);
   CHECK(hrg::fw::Mode::operate == r.final_mode);
-  // No drive while in fault: the excitation flag is off on every fault row.
+  // No drive while in fault: the excitation command is off on every fault
+  // row (the recording's exc also covers the demodulator's span after it).
   for (const auto& row : r.rows) {
-    if (row.mode == static_cast<int>(hrg::fw::Mode::fault)) LONGS_EQUAL(0, row.exc);
+    if (row.mode == static_cast<int>(hrg::fw::Mode::fault)) LONGS_EQUAL(0, row.excitation_cmd);
   }
 }
 

@@ -223,6 +223,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim
   row.cy_v = st.chain.cy_v * c + st.chain.sy_v * s;
   row.sy_v = st.chain.sy_v * c - st.chain.cy_v * s;
   row.exc = drive_free ? 0 : 1;
+  row.excitation_cmd = st.excitation_on ? 1 : 0;
   row.pump_v = st.chain.pump_v;
   row.temp_c = ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;

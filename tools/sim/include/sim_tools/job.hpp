@@ -68,7 +68,8 @@ void derive_firmware_config(JobConfig& job);
 // One telemetry row (the recording's columns plus the truth).
 struct Row {
   double t_s, cx_v, sx_v, cy_v, sy_v;
-  int exc;
+  int exc;             // 1 unless the row's whole averaging span was free of drive
+  int excitation_cmd;  // the firmware's excitation command for this block
   double pump_v, temp_c, rate_dps;
   double pll_hz;  // the PLL (NCO) frequency; cx..sy are against the fixed f_ref_hz
   double quad_v;
