@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// The main job's telemetry audited against the seed's averaged model: with
+// the seed's physics only, the recording must be explained by the baseline
+// to the noise level (no misfit left for a catalogue effect to take up).
+#include <filesystem>
+#include <string>
+
+#include "audit/audit.hpp"
+#include "recording/recording.hpp"
+#include "sim_tools/job.hpp"
+#include "sim_tools/report.hpp"
+
+#include "support/cpputest.hpp"
+
+TEST_GROUP(SimTelemetryAudit){
+    // The simulated target is a process-wide singleton whose buffers outlive
+    // the test: its allocations are not leaks of this test.
+    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+}
+void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
+}
+;
+
+TEST(SimTelemetryAudit, TheBaselineFitsTheFreeDecaysToTheNoiseLevel) {
+  // GIVEN 200 s of the default job: ring-up, the rate-table sweep with its
+  // 1 s free-decay windows, and parks; the PLL moves the demodulator's NCO.
+  const hrg::simtools::JobConfig j = hrg::simtools::default_job(200.0, 8);
+  const hrg::simtools::JobResult r = hrg::simtools::run_job(j, {});
+  const auto path = std::filesystem::temp_directory_path() / "hrg_test_e2e_audit.csv";
+  hrg::simtools::write_telemetry(path, j, r);
+  const hrg::recording::Recording rec = hrg::recording::read_recording(path);
+  std::filesystem::remove(path);
+  // WHEN it is audited
+  const hrg::audit::AuditResult a = hrg::audit::run_audit(rec);
+  // THEN the baseline's free-decay rms is the white-noise level: cx..sy are
+  // against 2 pi f_ref t, as the format defines them, so nothing of the PLL's
+  // phase walk is left (read against the integrated PLL frequency instead,
+  // the misfit was 2.2 x the noise), and no excitation row is read as free.
+  CHECK(a.noise_v > 0.0);
+  CHECK_TEXT(a.fit_rms_before_v < 1.05 * a.noise_v, hrg::audit::to_text(a, "sim").c_str());
+  CHECK_TEXT(a.heldout_rms_v < 1.1 * a.noise_v, hrg::audit::to_text(a, "sim").c_str());
+  CHECK_TEXT(a.verdict != "unexplained" && a.verdict != "ambiguous",
+             hrg::audit::to_text(a, "sim").c_str());
+  // The seed resonator's anisotropy is what the baseline finds.
+  DOUBLES_EQUAL(j.sim.resonator.split_hz, a.baseline.split_hz, 0.05 * j.sim.resonator.split_hz);
+  DOUBLES_EQUAL(j.sim.resonator.dmu, a.baseline.dmu, 0.05 * j.sim.resonator.dmu);
+}
