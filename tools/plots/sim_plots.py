@@ -108,7 +108,7 @@ def main(out):
     axs[0].set_ylabel("a_A (V)")
     axs[1].plot(t, tel["a_b_v"])
     axs[1].set_ylabel("a_B quadrature (V)")
-    axs[2].plot(t, tel["f_ref_hz"])
+    axs[2].plot(t, tel["pll_hz"])
     axs[2].set_ylabel("PLL frequency (Hz)")
     axs[2].set_xlabel("t (s)")
     axs[0].set_title("Amplitude, quadrature and frequency (grey: free-decay windows)")
