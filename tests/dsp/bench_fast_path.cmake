@@ -1,21 +1,13 @@
 # SPDX-License-Identifier: MIT
 # Instructions per frame (one sample of each channel) of the fast path,
 # counted by callgrind (deterministic). Goal: <= 60 for Q1.31 on x86-64.
+include(${CMAKE_CURRENT_LIST_DIR}/../../tools/cmake/CallgrindCount.cmake)
 set(blocks 2000)
 set(frames_per_block 100)
 math(EXPR frames "${blocks} * ${frames_per_block}")
 set(q31_ir 0)
 foreach(type q31 f32 f64)
-  set(out_file ${WORK_DIR}/callgrind.fast_path.${type})
-  execute_process(COMMAND ${VALGRIND} --tool=callgrind --callgrind-out-file=${out_file}
-      --toggle-collect=hrg_bench_fast_path_${type} ${BENCH} ${type} ${blocks}
-    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "callgrind run of ${BENCH} ${type} failed (${rc})")
-  endif()
-  file(STRINGS ${out_file} totals REGEX "^(summary|totals):")
-  list(GET totals 0 line)
-  string(REGEX MATCH "[0-9]+" ir "${line}")
+  hrg_callgrind_count(ir fast_path.${type} hrg_bench_fast_path_${type} ${type} ${blocks})
   math(EXPR per_frame_x100 "${ir} * 100 / ${frames}")
   math(EXPR whole "${per_frame_x100} / 100")
   math(EXPR frac "${per_frame_x100} % 100")
@@ -29,16 +21,7 @@ foreach(type q31 f32 f64)
 endforeach()
 # Whole chain per call (one block): what the firmware's base frame pays.
 foreach(type q31 f32)
-  set(out_file ${WORK_DIR}/callgrind.chain.${type})
-  execute_process(COMMAND ${VALGRIND} --tool=callgrind --callgrind-out-file=${out_file}
-      --toggle-collect=hrg_bench_chain_${type} ${BENCH} chain_${type} ${blocks}
-    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "callgrind run of ${BENCH} chain_${type} failed (${rc})")
-  endif()
-  file(STRINGS ${out_file} totals REGEX "^(summary|totals):")
-  list(GET totals 0 line)
-  string(REGEX MATCH "[0-9]+" ir "${line}")
+  hrg_callgrind_count(ir chain.${type} hrg_bench_chain_${type} chain_${type} ${blocks})
   math(EXPR per_block "${ir} / ${blocks}")
   math(EXPR per_frame "${ir} / ${frames}")
   message("whole chain ${type}: ${per_block} instructions per block of ${frames_per_block} frames (${per_frame} per frame)")

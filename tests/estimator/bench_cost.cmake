@@ -1,17 +1,9 @@
 # SPDX-License-Identifier: MIT
 # Instructions per estimator step, counted by callgrind (deterministic, x86-64
 # host build; a Cortex-M7 with a double FPU runs a comparable count).
+include(${CMAKE_CURRENT_LIST_DIR}/../../tools/cmake/CallgrindCount.cmake)
 function(count op fn count per what)
-  set(out_file ${WORK_DIR}/callgrind.estimator.${op})
-  execute_process(COMMAND ${VALGRIND} --tool=callgrind --callgrind-out-file=${out_file}
-      --toggle-collect=${fn} ${BENCH} ${op} ${count}
-    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "callgrind run of ${BENCH} ${op} failed (${rc})")
-  endif()
-  file(STRINGS ${out_file} totals REGEX "^(summary|totals):")
-  list(GET totals 0 line)
-  string(REGEX MATCH "[0-9]+" ir "${line}")
+  hrg_callgrind_count(ir estimator.${op} ${fn} ${op} ${count})
   math(EXPR each "${ir} / ${per}")
   message("estimator ${what}: ${ir} instructions / ${per} = ${each} per call")
 endfunction()
