@@ -2,6 +2,7 @@
 // Averaged model against the closed-form rates of physics.md sections 1-2.
 #include <cmath>
 
+#include "free_decay_rates.hpp"
 #include "sim_target/averaged_model.hpp"
 
 #include "support/cpputest.hpp"
@@ -20,7 +21,7 @@ TEST(AveragedModel, FreeDecayRateFollowsDampingAnisotropyAtSeveralAngles) {
     m.advance(10.0);
     const WaveState w = m.wave();
     const double rate = -std::log(w.a_a_v) / 10.0;
-    const double expected = p.nu_per_s() * (1.0 + p.dmu * std::cos(4.0 * (theta - p.th_mu_rad)));
+    const double expected = test::amplitude_decay_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-3 * expected);
   }
 }
@@ -35,7 +36,7 @@ TEST(AveragedModel, QuadratureGrowsAtHalfSplitTimesSinFourTheta) {
     m.advance(0.5);
     const WaveState w = m.wave();
     const double rate = w.a_b_v / 0.5;  // a_B(0) = 0, a_A ~ 1
-    const double expected = p.half_split_rad_s() * std::sin(4.0 * (theta - p.th_w_rad));
+    const double expected = test::quadrature_growth_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-2 * std::abs(expected));
   }
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 
+#include "free_decay_rates.hpp"
 #include "sim_target/averaged_model.hpp"
 #include "sim_target/resonator.hpp"
 
@@ -52,7 +53,7 @@ TEST(Resonator, FreeDecayRateFollowsDampingAnisotropyAtSeveralAngles) {
     ring(r, 2.0);
     // THEN a_A decays at nu (1 + dmu cos 4(theta - th_mu)) within 0.1 %
     const double rate = -std::log(true_wave(r).a_a_v) / 2.0;
-    const double expected = p.nu_per_s() * (1.0 + p.dmu * std::cos(4.0 * (theta - p.th_mu_rad)));
+    const double expected = test::amplitude_decay_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-3 * expected);
   }
 }
@@ -67,8 +68,7 @@ TEST(Resonator, QuadratureGrowsAtHalfSplitTimesSinFourTheta) {
     ring(r, 0.5);
     const WaveState w = true_wave(r);
     // a_B' = dw sin4(theta - th_w) a_A with dw = pi split (half split, rad/s)
-    const double expected =
-        p.half_split_rad_s() * std::sin(4.0 * (theta - p.th_w_rad)) * 0.5 * (1.0 + w.a_a_v) * 0.5;
+    const double expected = test::quadrature_growth_per_s(p, theta) * 0.5 * (1.0 + w.a_a_v) * 0.5;
     DOUBLES_EQUAL(expected, w.a_b_v, 1e-2 * std::abs(expected));
   }
 }
