@@ -206,12 +206,28 @@ void derive_firmware_config(JobConfig& j) {
 
 namespace {
 
+// The true state half-way between two instants (slow quantities, linear).
+sim::TrueState midpoint(const sim::TrueState& a, const sim::TrueState& b) {
+  sim::TrueState m = a;
+  m.t_s = 0.5 * (a.t_s + b.t_s);
+  m.pattern_angle_rad = 0.5 * (a.pattern_angle_rad + b.pattern_angle_rad);
+  m.input_angle_rad = 0.5 * (a.input_angle_rad + b.input_angle_rad);
+  m.energy_v2 = 0.5 * (a.energy_v2 + b.energy_v2);
+  m.a_a_v = 0.5 * (a.a_a_v + b.a_a_v);
+  m.a_b_v = 0.5 * (a.a_b_v + b.a_b_v);
+  m.rate_rad_s = 0.5 * (a.rate_rad_s + b.rate_rad_s);
+  m.temp_c = 0.5 * (a.temp_c + b.temp_c);
+  return m;
+}
+
 void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim::TrueState& ts,
                 double ref_offset_rad, bool drive_free, double true_angle0, double out0,
                 double raw0) {
   const fw::GyroStatus& st = g.status();
   Row row{};
-  row.t_s = st.chain.t_s;
+  // The row is the state at the centre of the demodulator's window, where
+  // the envelope is (ts is taken there too).
+  row.t_s = ts.t_s;
   // The chain demodulates against its NCO, whose phase the PLL moves every
   // block. The recording's cx..sy are against the fixed metadata reference
   // (ph = 2 pi f_ref t): x = Re((cx - i sx) e^(i ph_nco)) = Re((cx' - i sx')
@@ -417,6 +433,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   fw::Mode last_mode = fw::Mode::power_up;
   // NCO phase minus 2 pi f_ref t at the end of this block and the two before.
   double ref_offset_hist[3] = {0.0, 0.0, 0.0};
+  // The true state at the same three instants.
+  sim::TrueState true_hist[3];
   // A row is free of any drive once the last driven DAC word (played
   // dac_lead_frames + the DAC's pipeline latency after its block) lies before
   // the 3 L - 2 samples the demodulator averages: exc = 0 only from then on.
@@ -453,6 +471,9 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       ref_offset_hist[2] = ref_offset_hist[1];
       ref_offset_hist[1] = ref_offset_hist[0];
       ref_offset_hist[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
+      true_hist[2] = true_hist[1];
+      true_hist[1] = true_hist[0];
+      true_hist[0] = target.true_state();
     }
     if (st.mode != last_mode) {
       ++r.mode_changes;
@@ -485,8 +506,14 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       r.can_frames += target.can().sent().size();
       target.can().clear_sent();
     }
-    if (k % row_every != 0) continue;
-    const sim::TrueState ts = target.true_state();
+    if (k % row_every != 0 || k < 2) continue;  // rows from a full history on
+    // The decimating filter's output is centred 1.5 L - 1 samples before the
+    // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
+    // states one and two blocks back. Rate, temperature and the true angles
+    // are written at that instant: stamped at the block end instead, a rate
+    // ramp of 10 deg/s^2 puts a 0.015 deg/s error into the input rate the
+    // envelope saw, which the audit takes for a pickoff gain mismatch.
+    const sim::TrueState ts = midpoint(true_hist[1], true_hist[2]);
     if (!have_ref && st.out_valid) {
       // Angles are compared from the first valid output on.
       true0 = ts.input_angle_rad;
@@ -494,9 +521,6 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       raw0 = st.out_raw_angle_rad;
       have_ref = true;
     }
-    // The decimating filter's output is centred 1.5 L - 1 samples before the
-    // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
-    // NCO offsets one and two blocks back.
     const double ref_offset_rad =
         ref_offset_hist[1] +
         0.5 * std::remainder(ref_offset_hist[2] - ref_offset_hist[1], 2.0 * kPi);
