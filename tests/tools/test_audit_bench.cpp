@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 // A small run of the audit benchmark with its rates asserted (slow).
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "audit/bench.hpp"
+#include "../../tools/audit/src/campaign.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -23,4 +26,57 @@ TEST(AuditBenchmark, ConcealedEffectsAreFoundAndNullsStayClean) {
   // parameter within 20 %: at least 4 of 5 in this small sample.
   CHECK(r.above2x >= 3);
   CHECK(5 * r.above2x_hits >= 4 * r.above2x);
+}
+
+namespace {
+
+double threshold_of(const hrg::audit::AuditResult& r, hrg::audit::Effect e) {
+  for (const auto& c : r.candidates) {
+    if (c.effect == e && c.testable) return c.threshold;
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+TEST_GROUP(AuditFirmwareCampaign){
+    // The simulated target is a process-wide singleton whose buffers outlive
+    // the test: its allocations are not leaks of this test.
+    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+}
+void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
+}
+;
+
+TEST(AuditFirmwareCampaign, NullIsConsistentAndConcealedEffectsAreFound) {
+  using hrg::audit::Effect;
+  namespace bench = hrg::audit::bench;
+  // GIVEN the firmware's own telemetry (dsp chain, loops and window
+  // scheduler against the full-rate resonator): ring-up, the table's turn
+  // with its 1 s acceleration ramps, short free-decay windows.
+  const uint64_t seed = 100005;
+  const bench::Scenario base = bench::random_scenario(bench::Design::firmware, 0.0, seed);
+  CHECK(base.window_s >= 0.3 && base.window_s <= 1.0);
+  const hrg::audit::AuditResult null = hrg::audit::run_audit(bench::simulate(base));
+  // THEN with nothing concealed the seed's model explains it.
+  STRCMP_EQUAL_TEXT("consistent", null.verdict.c_str(), hrg::audit::to_text(null, "null").c_str());
+  // AND an effect in the pickoffs, in the free-decay frequency and one that
+  // acts only while the pump is on, each at 3x this design's threshold, is
+  // the top finding with its parameter within 20 %.
+  const struct {
+    Effect effect;
+    const char* id;
+  } cases[] = {{Effect::pickoff_phase_mismatch, "pickoff_phase_mismatch"},
+               {Effect::duffing_stiffness, "duffing_stiffness"},
+               {Effect::electrostatic_spring, "electrostatic_spring"}};
+  for (const auto& c : cases) {
+    const double value = 3.0 * threshold_of(null, c.effect);
+    CHECK_TEXT(value > 0.0, c.id);
+    bench::Scenario s = base;
+    CHECK(bench::conceal_by_id(s, c.id, value, seed));
+    const hrg::audit::AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+    CHECK_TEXT(!r.findings.empty(), hrg::audit::to_text(r, c.id).c_str());
+    CHECK_TEXT(r.findings.front().effect == c.effect, hrg::audit::to_text(r, c.id).c_str());
+    DOUBLES_EQUAL(value, r.findings.front().value, 0.2 * std::abs(value));
+  }
 }

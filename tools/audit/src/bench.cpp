@@ -43,6 +43,15 @@ void conceal(Scenario& s, Effect e, double v, std::mt19937_64& g) {
 
 }  // namespace
 
+const char* bench::design_name(Design d) {
+  switch (d) {
+    case Design::ringdown: return "ring-down";
+    case Design::telemetry: return "telemetry";
+    case Design::firmware: return "firmware telemetry";
+  }
+  return "?";
+}
+
 bool bench::conceal_by_id(Scenario& s, const std::string& id, double value, uint64_t seed) {
   std::mt19937_64 g(seed);
   for (const auto& info : effect_table()) {
@@ -55,6 +64,17 @@ bool bench::conceal_by_id(Scenario& s, const std::string& id, double value, uint
 }
 
 namespace {
+
+// Designs cycle ring-down, telemetry, firmware (or alternate the first two).
+Design design_of(const BenchOptions& o, int d) {
+  if (o.firmware) return static_cast<Design>(d % 3);
+  return d % 2 == 0 ? Design::ringdown : Design::telemetry;
+}
+
+// The top finding is the concealed effect with its parameter within 20 %.
+bool is_hit(const BenchCase& c) {
+  return c.top == c.truth && std::abs(c.top_value - c.true_value) <= 0.2 * std::abs(c.true_value);
+}
 
 int top_of(const AuditResult& r, double& value) {
   if (r.findings.empty()) return -1;
@@ -77,15 +97,15 @@ BenchResult run_benchmark(const BenchOptions& o) {
     return std::make_pair(r, s);
   };
   for (int d = 0; d < o.designs; ++d) {
-    const bool tele = d % 2 == 1;
+    const Design kind = design_of(o, d);
     const uint64_t seed = o.seed * 100003ULL + static_cast<uint64_t>(d);
-    const Scenario base = bench::random_scenario(tele ? Design::telemetry : Design::ringdown,
-                                                 tele ? o.telemetry_s : o.ringdown_s, seed);
+    const Scenario base =
+        bench::random_scenario(kind, kind == Design::ringdown ? o.ringdown_s : o.telemetry_s, seed);
     // Null twin: the same resonator, campaign and noise with nothing concealed.
     const auto [null_r, null_s] = timed_audit(bench::simulate(base));
     BenchCase nc;
     nc.design = d;
-    nc.telemetry = tele;
+    nc.campaign = kind;
     nc.top = top_of(null_r, nc.top_value);
     nc.verdict = null_r.verdict;
     nc.seconds = null_s;
@@ -94,7 +114,7 @@ BenchResult run_benchmark(const BenchOptions& o) {
     if (nc.top >= 0) ++res.null_findings;
     res.confusion[kEffectCount][nc.top >= 0 ? static_cast<std::size_t>(nc.top) : kEffectCount]++;
     if (o.verbose) {
-      std::fprintf(stderr, "design %d (%s) null: %s\n", d, tele ? "telemetry" : "ring-down",
+      std::fprintf(stderr, "design %d (%s) null: %s\n", d, bench::design_name(kind),
                    null_r.verdict.c_str());
     }
     std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
@@ -103,7 +123,7 @@ BenchResult run_benchmark(const BenchOptions& o) {
       if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
       BenchCase c;
       c.design = d;
-      c.telemetry = tele;
+      c.campaign = kind;
       c.truth = static_cast<int>(cand.effect);
       c.strength = 0.3 + 2.7 * u(g);
       const double sign = u(g) < 0.5 ? -1.0 : 1.0;
@@ -128,21 +148,19 @@ BenchResult run_benchmark(const BenchOptions& o) {
       c.seconds = secs;
       res.confusion[static_cast<std::size_t>(c.truth)]
                    [c.top >= 0 ? static_cast<std::size_t>(c.top) : kEffectCount]++;
-      const bool right = c.top == c.truth;
-      const bool close = std::abs(c.top_value - c.true_value) <= 0.2 * std::abs(c.true_value);
       if (c.strength >= 2.0) {
         ++res.above2x;
-        if (right && close) ++res.above2x_hits;
+        if (is_hit(c)) ++res.above2x_hits;
       }
       if (c.strength < 1.0) {
         ++res.below1x;
-        if (right) ++res.below1x_found;
+        if (c.top == c.truth) ++res.below1x_found;
       }
       if (o.verbose) {
         std::fprintf(stderr, "  %-24s x%.2f true %.4g -> %s %s %.4g%s\n",
                      effect_info(cand.effect).id, c.strength, c.true_value, r.verdict.c_str(),
                      c.top >= 0 ? effect_info(static_cast<Effect>(c.top)).id : "-", c.top_value,
-                     c.strength >= 2.0 && !(right && close) ? "   <-- MISS" : "");
+                     c.strength >= 2.0 && !is_hit(c) ? "   <-- MISS" : "");
       }
       res.cases.push_back(c);
     }
@@ -190,6 +208,24 @@ std::string format_benchmark(const BenchResult& r) {
                 "Not scored (threshold beyond a physical damping change in that design): %d\n",
                 r.unscored);
   o += buf;
+  o += "By campaign design:\n";
+  for (Design kind : {Design::ringdown, Design::telemetry, Design::firmware}) {
+    int hits = 0, above = 0, nulls = 0, null_found = 0;
+    for (const auto& c : r.cases) {
+      if (c.campaign != kind) continue;
+      if (c.truth < 0) {
+        ++nulls;
+        if (c.top >= 0) ++null_found;
+      } else if (c.strength >= 2.0) {
+        ++above;
+        if (is_hit(c)) ++hits;
+      }
+    }
+    if (nulls == 0) continue;
+    std::snprintf(buf, sizeof buf, "  %-20s hits above 2x %d/%d, nulls with a finding %d/%d\n",
+                  bench::design_name(kind), hits, above, null_found, nulls);
+    o += buf;
+  }
   // Confusable pairs of the catalogue.
   struct Pair {
     Effect a, b;

@@ -59,6 +59,24 @@ std::vector<Segment> plan(const Scenario& s, std::mt19937_64& g) {
   return out;
 }
 
+// What the firmware's default chain and loops are built for: a resonance
+// within its PLL's pull-in of the 5 kHz centre, a pump threshold well inside
+// the 10 V DAC, an amplitude inside the 2.5 V ADC; the table's turn at
+// 6-15 deg/s and windows of 0.3-1 s. The campaign lasts as long as the turn.
+void restrict_to_firmware(Scenario& s, std::mt19937_64& g) {
+  auto& r = s.resonator;
+  r.f_hz = 5000.0 + uniform(g, -1.0, 1.0);
+  r.q = std::exp(uniform(g, std::log(2e6), std::log(8e6)));
+  s.amplitude_v = uniform(g, 0.6, 1.4);
+  s.noise_v = s.amplitude_v * std::exp(uniform(g, std::log(1e-5), std::log(6e-5)));
+  const double v_th = uniform(g, 2.5, 5.0);
+  s.electrodes.pump_gain_per_s2_v2 = 8.0 * r.omega_rad_s() * r.nu_per_s() / (v_th * v_th);
+  s.window_s = uniform(g, 0.3, 1.0);
+  s.sweep_rate_dps = uniform(g, 6.0, 15.0) * (uniform(g, 0, 1) < 0.5 ? -1 : 1);
+  s.temp_phase_rad = uniform(g, 0.0, 2.0 * kPi);
+  s.duration_s = firmware_duration_s(s);
+}
+
 }  // namespace
 
 Scenario random_scenario(Design design, double duration_s, uint64_t seed) {
@@ -84,10 +102,12 @@ Scenario random_scenario(Design design, double duration_s, uint64_t seed) {
   // Pump gain giving a parametric threshold of 6-12 V at this damping.
   const double v_th = uniform(g, 6.0, 12.0);
   s.electrodes.pump_gain_per_s2_v2 = 8.0 * r.omega_rad_s() * r.nu_per_s() / (v_th * v_th);
+  if (design == Design::firmware) restrict_to_firmware(s, g);
   return s;
 }
 
 recording::Recording simulate(const Scenario& s) {
+  if (s.design == Design::firmware) return simulate_firmware(s);
   std::mt19937_64 g(s.seed * 104729ULL + 3ULL);
   std::normal_distribution<double> noise(0.0, s.noise_v);
   const auto segs = plan(s, g);

@@ -9,17 +9,21 @@
 //    a free decay of 10-30 s, some under a turning rate table, one long decay;
 //  - telemetry: the firmware's interval shutdown, excitation for 4-10 s with
 //    the pattern free under a stepped rate, short free windows of 0.4-2 s.
+// And from the firmware itself:
+//  - firmware: `hrg sim`'s job (the firmware's dsp chain, loops and window
+//    scheduler against sim_target's full-rate resonator in lockstep): ring-up
+//    from rest, the table turning the pattern twice through the 4 theta
+//    circle with 0.3-1 s windows, recorded as the job's telemetry.
 
 #include <cstdint>
 #include <random>
 #include <string>
 
+#include "audit/bench.hpp"
 #include "recording/recording.hpp"
 #include "sim_target/params.hpp"
 
 namespace hrg::audit::bench {
-
-enum class Design { ringdown, telemetry };
 
 struct Scenario {
   Design design = Design::ringdown;
@@ -32,6 +36,10 @@ struct Scenario {
   double duration_s = 600.0;
   double sample_rate_hz = 200.0;
   double temp_mean_c = 25.0, temp_swing_c = 1.0;  // slow temperature swing
+  double temp_phase_rad = 0.0;
+  // Firmware campaigns only.
+  double window_s = 1.0;         // free-decay window length
+  double sweep_rate_dps = 10.0;  // case rate of the table's turn
   uint64_t seed = 1;
 };
 
@@ -45,5 +53,10 @@ bool conceal_by_id(Scenario& s, const std::string& id, double value, uint64_t se
 
 // Simulates the campaign and returns the recording (deterministic in seed).
 recording::Recording simulate(const Scenario& s);
+
+// The firmware campaign (simulate() of Design::firmware) and its length: the
+// ring-up, the table's turn and 10 s after it.
+recording::Recording simulate_firmware(const Scenario& s);
+double firmware_duration_s(const Scenario& s);
 
 }  // namespace hrg::audit::bench

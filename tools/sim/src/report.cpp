@@ -177,66 +177,97 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   return w.str();
 }
 
+namespace {
+
+const std::vector<std::string>& telemetry_columns() {
+  static const std::vector<std::string> cols{"t_s",
+                                             "cx_v",
+                                             "sx_v",
+                                             "cy_v",
+                                             "sy_v",
+                                             "exc",
+                                             "pump_v",
+                                             "temp_c",
+                                             "rate_dps",
+                                             "pll_hz",
+                                             "quad_v",
+                                             "mode",
+                                             "theta_deg",
+                                             "out_angle_deg",
+                                             "true_angle_deg",
+                                             "raw_angle_deg",
+                                             "true_theta_deg",
+                                             "a_a_v",
+                                             "a_b_v",
+                                             "drift_model_dph",
+                                             "drift_true_dph",
+                                             "out_valid",
+                                             "pattern_cmd",
+                                             "raw_error_deg",
+                                             "out_error_deg"};
+  return cols;
+}
+
+// One row's values in telemetry_columns() order.
+void telemetry_values(const Row& row, std::vector<double>& v) {
+  v = {row.t_s,
+       row.cx_v,
+       row.sx_v,
+       row.cy_v,
+       row.sy_v,
+       double(row.exc),
+       row.pump_v,
+       row.temp_c,
+       row.rate_dps,
+       row.pll_hz,
+       row.quad_v,
+       double(row.mode),
+       row.theta_deg,
+       row.out_angle_deg,
+       row.true_angle_deg,
+       row.raw_angle_deg,
+       row.true_theta_deg,
+       row.a_a_v,
+       row.a_b_v,
+       row.drift_model_dph,
+       row.drift_true_dph,
+       double(row.out_valid),
+       double(row.pattern_cmd),
+       row.raw_error_deg,
+       row.out_error_deg};
+}
+
+std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobConfig& job) {
+  return {{"source", "hrg sim (firmware + sim_target in lockstep)"},
+          {"scenario", job.description},
+          {"quad_v", "a_B, the quadrature wave amplitude"}};
+}
+
+}  // namespace
+
 void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r) {
-  std::vector<std::string> cols{"t_s",
-                                "cx_v",
-                                "sx_v",
-                                "cy_v",
-                                "sy_v",
-                                "exc",
-                                "pump_v",
-                                "temp_c",
-                                "rate_dps",
-                                "pll_hz",
-                                "quad_v",
-                                "mode",
-                                "theta_deg",
-                                "out_angle_deg",
-                                "true_angle_deg",
-                                "raw_angle_deg",
-                                "true_theta_deg",
-                                "a_a_v",
-                                "a_b_v",
-                                "drift_model_dph",
-                                "drift_true_dph",
-                                "out_valid",
-                                "pattern_cmd",
-                                "raw_error_deg",
-                                "out_error_deg"};
-  recording::RecordingWriter wr(path, cols, job.chain.f_center_hz, job.gyro.angular_gain,
-                                {{"source", "hrg sim (firmware + sim_target in lockstep)"},
-                                 {"scenario", job.description},
-                                 {"quad_v", "a_B, the quadrature wave amplitude"}});
-  std::vector<double> v(cols.size());
+  // Streamed row by row: an hour of telemetry is not held twice in memory.
+  recording::RecordingWriter wr(path, telemetry_columns(), job.chain.f_center_hz,
+                                job.gyro.angular_gain, telemetry_metadata(job));
+  std::vector<double> v;
   for (const Row& row : r.rows) {
-    v = {row.t_s,
-         row.cx_v,
-         row.sx_v,
-         row.cy_v,
-         row.sy_v,
-         double(row.exc),
-         row.pump_v,
-         row.temp_c,
-         row.rate_dps,
-         row.pll_hz,
-         row.quad_v,
-         double(row.mode),
-         row.theta_deg,
-         row.out_angle_deg,
-         row.true_angle_deg,
-         row.raw_angle_deg,
-         row.true_theta_deg,
-         row.a_a_v,
-         row.a_b_v,
-         row.drift_model_dph,
-         row.drift_true_dph,
-         double(row.out_valid),
-         double(row.pattern_cmd),
-         row.raw_error_deg,
-         row.out_error_deg};
+    telemetry_values(row, v);
     wr.write_row(v);
   }
   wr.close();
+}
+
+recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r) {
+  recording::Recording rec(telemetry_columns(), job.chain.f_center_hz, job.gyro.angular_gain);
+  for (const auto& [key, value] : telemetry_metadata(job))
+    rec.set_metadata(key, value);
+  std::vector<double> v;
+  for (const Row& row : r.rows) {
+    telemetry_values(row, v);
+    rec.append_row(v);
+  }
+  rec.find_gaps();
+  return rec;
 }
 
 void write_bias_csv(const std::filesystem::path& path, const JobResult& r) {

@@ -13,17 +13,25 @@
 // threshold, and null recordings, in ring-down and telemetry campaigns.
 namespace hrg::audit {
 
+namespace bench {
+// Campaign designs: ring-down and envelope-controller telemetry from the
+// averaged model, and the firmware's own telemetry (see campaign.hpp).
+enum class Design { ringdown, telemetry, firmware };
+const char* design_name(Design d);
+}  // namespace bench
+
 struct BenchOptions {
   int designs = 10;  // random resonators/campaigns; each gives 1 null + 1 per effect
   uint64_t seed = 1;
   double ringdown_s = 480.0;
   double telemetry_s = 360.0;
+  bool firmware = true;  // every third design is the firmware's telemetry
   bool verbose = false;
 };
 
 struct BenchCase {
   int design = 0;
-  bool telemetry = false;
+  bench::Design campaign = bench::Design::ringdown;
   int truth = -1;           // Effect index, -1 = null
   double strength = 0.0;    // multiple of the detection threshold
   double true_value = 0.0;  // catalogue parameter

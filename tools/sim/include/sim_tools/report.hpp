@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "recording/recording.hpp"
 #include "sim_tools/job.hpp"
 
 namespace hrg::simtools {
@@ -17,6 +18,8 @@ std::string report_json(const JobConfig& job, const JobResult& r);
 // telemetry.csv: hrg-recording v1 plus theta_deg, out_angle_deg,
 // true_angle_deg, mode and the truth columns.
 void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r);
+// The same telemetry as a recording in memory.
+recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r);
 
 // bias.csv (one row per parked angle) and allan.csv (tau, adev) for the plots.
 void write_bias_csv(const std::filesystem::path& path, const JobResult& r);
