@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The audit against recordings whose truth is known: the shared examples
 // and sim_target campaigns (slow: each is a full audit).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
@@ -211,4 +213,41 @@ TEST(AuditSimulated, AmplitudeMovingAtItsOwnTemperatureIsDuffing) {
   CHECK(!r.findings.empty());
   CHECK(r.findings.front().effect == Effect::duffing_stiffness);
   DOUBLES_EQUAL(c.c_hz_per_v2, r.findings.front().value, 0.2 * std::abs(c.c_hz_per_v2));
+}
+
+TEST(AuditSimulated, WithoutTheRateColumnATurningPatternIsLocatedNotExplained) {
+  // GIVEN a telemetry campaign under stepped table rates, recorded without
+  // its rate_dps column (a CAN log of the gyro alone)
+  auto s = hrg::audit::bench::random_scenario(hrg::audit::bench::Design::telemetry, 300.0, 5);
+  const auto full = hrg::audit::bench::simulate(s);
+  hrg::recording::Recording rec({"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc", "pump_v", "temp_c"},
+                                full.f_ref_hz(), full.angular_gain());
+  for (std::size_t i = 0; i < full.rows(); ++i) {
+    rec.append_row({full.column("t_s")[i], full.column("cx_v")[i], full.column("sx_v")[i],
+                    full.column("cy_v")[i], full.column("sy_v")[i], full.column("exc")[i],
+                    full.column("pump_v")[i], full.column("temp_c")[i]});
+  }
+  // WHEN audited
+  const AuditResult r = hrg::audit::run_audit(rec);
+  // THEN the misfit is not claimed by a catalogue effect, and the worst free
+  // decays are located with the pattern's own turn, -K Omega / 2 of the rate
+  // the table had there (physics.md section 1), and the advice to add it.
+  STRCMP_EQUAL("unexplained", r.verdict.c_str());
+  int located = 0;
+  for (const auto& loc : r.locations) {
+    double t0 = 0, t1 = 0, turn_dps = 0;
+    if (std::sscanf(loc.where.c_str(),
+                    "free decay %lf-%lf s (no rate_dps column; the pattern turns at %lf deg/s", &t0,
+                    &t1, &turn_dps) != 3) {
+      continue;
+    }
+    CHECK_TEXT(loc.where.find("add the input rate") != std::string::npos, loc.where.c_str());
+    const auto& t = full.column("t_s");
+    const std::size_t i =
+        static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0) - t.begin());
+    const double expected_dps = -0.5 * full.angular_gain() * full.column("rate_dps")[i];
+    DOUBLES_EQUAL(expected_dps, turn_dps, 0.02 * std::abs(expected_dps) + 0.01);
+    ++located;
+  }
+  CHECK(located >= 1);
 }

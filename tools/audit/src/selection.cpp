@@ -23,6 +23,22 @@ std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
   return buf;
 }
 
+// The input rate a free decay saw: the recording's, or, without a rate_dps
+// column, the pattern's own measured turn. The model then holds the pattern
+// still, and a turn well beyond the angle noise is misfit for that alone.
+std::string rate_note(const Dataset& d, const FreeSegment& s) {
+  const Block& first = d.blocks[s.first_block];
+  if (d.has_rate) return fmt(" (mean |rate| %.3g deg/s)", std::abs(first.rate_rad_s) * 180.0 / kPi);
+  const Block& last = d.blocks[s.first_block + s.n_blocks - 1];
+  if (!(last.t_s > first.t_s) || !(first.a2_v2 > 0.0)) return "";
+  const double turn_rad = last.theta_rad - first.theta_rad;
+  const double angle_noise_rad = d.noise_v / std::sqrt(first.a2_v2);
+  const bool significant = std::abs(turn_rad) > 20.0 * angle_noise_rad;
+  return fmt(" (no rate_dps column; the pattern turns at %.3g deg/s there",
+             turn_rad / (last.t_s - first.t_s) * 180.0 / kPi) +
+         (significant ? ", which the model holds still: add the input rate)" : ")");
+}
+
 using Vec4 = Eigen::Vector4d;
 
 Vec4 real4(const std::array<cplx, 2>& z) {
@@ -289,9 +305,7 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
     const double z = segs[i].excess / std::sqrt(8.0 * static_cast<double>(s.n_blocks));
     if (z < 5.0) break;
     out.push_back({"cx_v,sx_v,cy_v,sy_v",
-                   fmt("free decay %.2f-%.2f s", s.t0_s, s.t1_s) +
-                       fmt(" (mean |rate| %.3g deg/s)",
-                           std::abs(d.blocks[s.first_block].rate_rad_s) * 180.0 / kPi),
+                   fmt("free decay %.2f-%.2f s", s.t0_s, s.t1_s) + rate_note(d, s),
                    segs[i].excess});
   }
   // 4-theta harmonic explained chi^2 (projection onto cos4, sin4 after the mean).
