@@ -13,6 +13,18 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def before_after(ax, x, y_before, y_after, xlabel, ylabel, title, log=False):
+    """One residual panel: the baseline's and the selected model's points."""
+    ax.plot(x, y_before, ".", ms=1.5, label="baseline")
+    ax.plot(x, y_after, ".", ms=1.5, label="selected model")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if log:
+        ax.set_yscale("log")
+    ax.legend()
+    ax.set_title(title)
+
+
 def main():
     csv, out, title = sys.argv[1], sys.argv[2], sys.argv[3]
     d = np.genfromtxt(csv, delimiter=",", names=True)
@@ -20,36 +32,19 @@ def main():
     th4 = np.mod(4.0 * d["theta_deg"], 360.0)
 
     fig, ax = plt.subplots(2, 2, figsize=(12, 8))
-    ax[0, 0].plot(t, d["res_before"], ".", ms=1.5, label="baseline")
-    ax[0, 0].plot(t, d["res_after"], ".", ms=1.5, label="selected model")
-    ax[0, 0].set_xlabel("t (s)")
-    ax[0, 0].set_ylabel("block residual rms (noise units)")
-    ax[0, 0].set_yscale("log")
-    ax[0, 0].legend()
-    ax[0, 0].set_title("residual against time (free decays)")
     da_b = d["a_meas_v"] - d["a_before_v"]
     da_a = d["a_meas_v"] - d["a_after_v"]
-    ax[0, 1].plot(th4, da_b, ".", ms=1.5, label="baseline")
-    ax[0, 1].plot(th4, da_a, ".", ms=1.5, label="selected model")
-    ax[0, 1].set_xlabel("4 theta (deg)")
-    ax[0, 1].set_ylabel("amplitude residual (V)")
-    ax[0, 1].legend()
-    ax[0, 1].set_title("amplitude residual against pattern angle")
     dq_b = d["q_meas_v"] - d["q_before_v"]
     dq_a = d["q_meas_v"] - d["q_after_v"]
-    ax[1, 0].plot(th4, dq_b, ".", ms=1.5, label="baseline")
-    ax[1, 0].plot(th4, dq_a, ".", ms=1.5, label="selected model")
-    ax[1, 0].set_xlabel("4 theta (deg)")
-    ax[1, 0].set_ylabel("quadrature a_B residual (V)")
-    ax[1, 0].legend()
-    ax[1, 0].set_title("quadrature residual against pattern angle")
-    ax[1, 1].plot(d["a_meas_v"] ** 2, d["res_before"], ".", ms=1.5, label="baseline")
-    ax[1, 1].plot(d["a_meas_v"] ** 2, d["res_after"], ".", ms=1.5, label="selected model")
-    ax[1, 1].set_xlabel("a_A^2 (V^2)")
-    ax[1, 1].set_ylabel("block residual rms (noise units)")
-    ax[1, 1].set_yscale("log")
-    ax[1, 1].legend()
-    ax[1, 1].set_title("residual against amplitude")
+    rms_label = "block residual rms (noise units)"
+    before_after(ax[0, 0], t, d["res_before"], d["res_after"], "t (s)", rms_label,
+                 "residual against time (free decays)", log=True)
+    before_after(ax[0, 1], th4, da_b, da_a, "4 theta (deg)", "amplitude residual (V)",
+                 "amplitude residual against pattern angle")
+    before_after(ax[1, 0], th4, dq_b, dq_a, "4 theta (deg)", "quadrature a_B residual (V)",
+                 "quadrature residual against pattern angle")
+    before_after(ax[1, 1], d["a_meas_v"] ** 2, d["res_before"], d["res_after"], "a_A^2 (V^2)",
+                 rms_label, "residual against amplitude", log=True)
     fig.suptitle("hrg audit residual map: " + title)
     fig.tight_layout()
     fig.savefig(out + "/residual_map.png", dpi=90)
