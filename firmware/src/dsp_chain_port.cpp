@@ -13,7 +13,7 @@ constexpr double kPi = std::numbers::pi;
 double wrap_pi(double a) { return a - 2.0 * kPi * std::round(a / (2.0 * kPi)); }
 }  // namespace
 
-dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig base) {
+dsp::ChainConfig chain_config_for(const ConverterLayout& conv, dsp::ChainConfig base) {
   base.sample_rate_hz = conv.sample_rate_hz;
   base.block_frames = conv.block_frames;
   base.adc_full_scale_v = conv.adc_full_scale_v;
@@ -22,15 +22,15 @@ dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig ba
   return base;
 }
 
-dsp::ChainConfig chain_config_for(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
-                                  double dac_latency_samples, dsp::ChainConfig base) {
-  ConverterInfo conv;
+ConverterLayout converter_layout(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
+                                 double dac_latency_samples) {
+  ConverterLayout conv;
   conv.sample_rate_hz = static_cast<double>(adc.sample_rate_hz);
   conv.block_frames = adc.block_frames;
   conv.adc_full_scale_v = adc.full_scale_v;
   conv.dac_full_scale_v = dac.full_scale_v;
   conv.dac_latency_samples = dac_latency_samples;
-  return chain_config_for(conv, base);
+  return conv;
 }
 
 double max_pattern_rate_rad_s(const dsp::ChainConfig& cfg, double margin) {

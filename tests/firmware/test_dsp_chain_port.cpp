@@ -61,7 +61,7 @@ Drive run_blocks(DspChainPort& port, const ChainCommands& cmd, double a_v, doubl
 TEST_GROUP(DspChainPort){};
 
 TEST(DspChainPort, TheChainConfigurationComesFromTheConverters) {
-  hrg::fw::ConverterInfo conv;
+  hrg::fw::ConverterLayout conv;
   conv.adc_full_scale_v = 2.5;
   conv.dac_full_scale_v = 10.0;
   conv.dac_latency_samples = 2.0;
@@ -122,7 +122,7 @@ TEST(DspChainPort, ThePatternRateIsClampedToWhatTheForcersCanDo) {
 TEST(DspChainPort, TheHalConverterInfoGivesTheSameConfiguration) {
   const hrg::hal::ConverterInfo adc{100000, 100, 2.5};
   const hrg::hal::ConverterInfo dac{100000, 100, 10.0};
-  const ChainConfig c = hrg::fw::chain_config_for(adc, dac, 2.0);
+  const ChainConfig c = hrg::fw::chain_config_for(hrg::fw::converter_layout(adc, dac, 2.0));
   DOUBLES_EQUAL(2.5, c.adc_full_scale_v, 0.0);
   DOUBLES_EQUAL(10.0, c.dac_full_scale_v, 0.0);
   DOUBLES_EQUAL(102.5, c.dac_lead_frames, 0.0);

@@ -49,9 +49,10 @@ TEST(EndToEnd, TheGyroRingsUpFromRestAndLocksWithinTheForcerRingUpTime) {
   // GIVEN a resonator at rest (1 mV) and forcers of gain g = 200 1/s^2 at up
   // to 5 V: a_A' = g u / (2 w) = 0.0159 V/s, so the forcers alone reach
   // 0.95 V in 60 s; the pump takes over above 0.9 V and the loops settle in 0.2 s.
-  const double w = 2 * kPi * job().chain.f_center_hz;
-  const double rate_v_s = job().chain.forcer_gain_per_s2 * job().chain.forcer_max_v / (2 * w);
-  const double bound_s = 0.95 * job().gyro.amplitude_set_v / rate_v_s + 1.0;
+  const double w = 2 * kPi * job().firmware.chain.f_center_hz;
+  const double rate_v_s =
+      job().firmware.chain.forcer_gain_per_s2 * job().firmware.chain.forcer_max_v / (2 * w);
+  const double bound_s = 0.95 * job().firmware.gyro.amplitude_set_v / rate_v_s + 1.0;
   CHECK(result().reached_operate);
   CHECK(result().t_operate_s > 1.0);
   CHECK(result().t_operate_s < bound_s);
@@ -111,7 +112,7 @@ TEST(EndToEnd, TheOutputTracksTheRateTableSweep) {
 
 TEST(EndToEnd, RunsFreeDecayWindowsUntilEveryBinHasItsMinimum) {
   const auto& r = result();
-  const auto& wc = job().gyro.windows;
+  const auto& wc = job().firmware.gyro.windows;
   CHECK(r.campaign_done);
   CHECK(r.windows >= wc.bins * wc.min_windows_per_bin);
   LONGS_EQUAL(r.windows, r.windows_accepted);
@@ -238,7 +239,7 @@ namespace {
 // injected fault from 10 s to 10.5 s.
 JobResult run_with_fault(hrg::simtools::FaultEvent::Kind kind) {
   JobConfig j = hrg::simtools::static_base_job(30.0);
-  j.gyro.identify = false;
+  j.firmware.gyro.identify = false;
   j.sim.initial.amplitude_v = 1.0;
   j.faults = {{10.0, kind, 1, true}, {10.5, kind, 1, false}};
   JobResult r = hrg::simtools::run_job(j, {});
@@ -291,7 +292,7 @@ TEST(InjectedFaults, AfterBusOffTheFirmwareRestartsTheCanControllerByItself) {
   // GIVEN the simulated controller forced bus-off at 5 s (TX queue dropped,
   // every send refused) and nothing else restarting it.
   JobConfig j = hrg::simtools::static_base_job(8.0);
-  j.gyro.identify = false;
+  j.firmware.gyro.identify = false;
   j.sim.initial.amplitude_v = 1.0;
   j.faults = {{5.0, hrg::simtools::FaultEvent::Kind::can_bus_off, 0, true}};
   const JobResult r = hrg::simtools::run_job(j, {});
@@ -315,7 +316,7 @@ JobResult run_control(bool compensate, bool gap) {
     j.sim.electrodes.eps_p = 0.02;
     j.sim.electrodes.eps_q = 0.01;
   }
-  j.gyro.compensate_control_drift = compensate;
+  j.firmware.gyro.compensate_control_drift = compensate;
   return hrg::simtools::run_job(j, {});
 }
 }  // namespace
@@ -352,7 +353,8 @@ TEST(ControlLoopDrift, TheGapHarmonicsOfThePumpAreCompensated) {
   const JobResult on = run_control(true, true);
   const JobConfig j = hrg::simtools::default_job(0.0, 16);
   const double nu = j.sim.resonator.nu_per_s();
-  const double expected_dph = nu * std::hypot(0.02, 0.01) / 2.0 / j.gyro.angular_gain * kRadSToDph;
+  const double expected_dph =
+      nu * std::hypot(0.02, 0.01) / 2.0 / j.firmware.gyro.angular_gain * kRadSToDph;
   CHECK(off.fit_comp.ok && on.fit_comp.ok);
   DOUBLES_EQUAL(expected_dph, off.fit_comp.amplitude(), 0.15 * expected_dph);
   // THEN with D_Phi in the output the compensated ADB drops by at least 40 %
@@ -392,7 +394,7 @@ TEST(Lockstep, TheTelemetryIsAnHrgRecordingV1ThatReadsBack) {
   std::filesystem::remove(path);
   LONGS_EQUAL(r.rows.size(), rec.rows());
   CHECK(rec.gaps().empty());
-  DOUBLES_EQUAL(j.gyro.angular_gain, rec.angular_gain(), 0.0);
+  DOUBLES_EQUAL(j.firmware.gyro.angular_gain, rec.angular_gain(), 0.0);
   for (const char* c : {"theta_deg", "out_angle_deg", "true_angle_deg", "mode", "rate_dps"}) {
     CHECK_TEXT(rec.has_column(c), c);
   }

@@ -130,7 +130,7 @@ int sim_main(std::span<char* const> args) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
   }
-  job.gyro.compensate_control_drift = control_drift;
+  job.firmware.gyro.compensate_control_drift = control_drift;
   const std::filesystem::path dir(out_dir);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -10,9 +10,9 @@
 
 namespace hrg::fw {
 
-// The converters as the chain must know them (from the board's data sheet or
-// the simulated target's configuration).
-struct ConverterInfo {
+// The converter layout as the chain must know it (from the board's HAL
+// converter info and data sheet, or the simulated target's configuration).
+struct ConverterLayout {
   double sample_rate_hz = 100000.0;
   uint32_t block_frames = 100;
   double adc_full_scale_v = 2.0;     // pickoff volts at Q1.31 full scale
@@ -23,11 +23,11 @@ struct ConverterInfo {
 // `base` with the converter fields filled in: the DAC block written after ADC
 // block n acts one block later, plus half a frame of zero-order hold, plus
 // the DAC's pipeline.
-dsp::ChainConfig chain_config_for(const ConverterInfo& conv, dsp::ChainConfig base = {});
-// The same from the board's HAL converter info (the DAC pipeline, which the
-// HAL does not describe, from the board's data sheet).
-dsp::ChainConfig chain_config_for(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
-                                  double dac_latency_samples, dsp::ChainConfig base = {});
+dsp::ChainConfig chain_config_for(const ConverterLayout& conv, dsp::ChainConfig base = {});
+// The layout of the board's HAL converters (the DAC pipeline, which the HAL
+// does not describe, from the board's data sheet).
+ConverterLayout converter_layout(const hal::ConverterInfo& adc, const hal::ConverterInfo& dac,
+                                 double dac_latency_samples);
 
 // Fastest pattern turn the forcers can make at the set point (rad/s of
 // theta_A): theta_A' = g u_r / (4 w a_A) with u_r at forcer_max_v, less

@@ -62,7 +62,7 @@ simtools::JobConfig firmware_job(const Scenario& s) {
   c.temp_c = sim::Profile::sine(s.temp_swing_c, 1.0 / (1.3 * s.duration_s), s.temp_phase_rad)
                  .add_offset(s.temp_mean_c);
   j.sweep_end_s = j.duration_s;
-  fw::GyroConfig& g = j.gyro;
+  fw::GyroConfig& g = j.firmware.gyro;
   g.amplitude_set_v = s.amplitude_v;
   g.windows.length_frames = static_cast<uint32_t>(std::lround(s.window_s * 1000.0));
   g.windows.period_frames = 2 * g.windows.length_frames;

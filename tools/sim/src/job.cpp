@@ -8,8 +8,7 @@
 #include <stdexcept>
 
 #include "can/candump_log.hpp"
-#include "firmware/dsp_chain_port.hpp"
-#include "firmware/estimator_port.hpp"
+#include "firmware/app/firmware.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
 #include "sim_target/control.hpp"
@@ -133,34 +132,14 @@ JobConfig default_job(double duration_s, int bias_angles) {
   j.duration_s = duration_s > 0 ? duration_s : sch.t;
   s.rate_rad_s = sim::Profile::ramps(sch.pts).add_offset(j.earth_rate_rad_s);
 
-  fw::GyroConfig& g = j.gyro;
-  g.angular_gain = k;
-  g.amplitude_set_v = 1.0;
-  // Long windows: the decay-rate information of one window grows as T^3
-  // (slope of a noisy line), so one 1 s window is worth about 20 windows of
-  // 130 ms for a quarter of the excitation-off time.
-  g.windows.length_frames = 1000;
-  g.windows.period_frames = 2000;
-  g.windows.max_wait_frames = 10000;
-  g.windows.bins = 16;
-  g.windows.windows_per_bin = 4;
-  g.windows.min_windows_per_bin = 2;
-  g.windows.condition_good = 50.0;
-  g.windows.coverage_good = 1.0;
-  // The rate table turns the pattern here; commanded rotation is for a base
-  // that never turns (the output is held while the pattern is moved).
-  g.windows.rotate_on_static_base = false;
-  if (long_run) {
-    // 4 windows of 5 s per 4 theta bin while the table turns (64 windows,
-    // 320 s: 8.9 % of an hour), 10 s apart so the AGC is back at the set
-    // point between them; each carries 125 times the decay information of a
-    // 1 s window. The campaign ends only when every bin has its 4.
-    g.windows.length_frames = 5000;
-    g.windows.period_frames = 10000;
-    g.windows.max_wait_frames = 20000;
-    g.windows.windows_per_bin = 4;
-    g.windows.min_windows_per_bin = 4;
-  }
+  // The firmware's defaults, K from the resonator's calibration. The rate
+  // table turns the pattern here; commanded rotation is for a base that
+  // never turns (the output is held while the pattern is moved).
+  j.firmware = fw::app::default_firmware_config(
+      converter_layout(s),
+      long_run ? fw::app::WindowPlan::long_run : fw::app::WindowPlan::standard);
+  j.firmware.gyro.angular_gain = k;
+  j.firmware.gyro.windows.rotate_on_static_base = false;
   derive_firmware_config(j);
   return j;
 }
@@ -174,7 +153,7 @@ JobConfig static_base_job(double duration_s) {
   j.parks.clear();
   j.duration_s = duration_s > 0 ? duration_s : 300.0;
   j.sweep_end_s = j.duration_s;
-  fw::WindowConfig& w = j.gyro.windows;
+  fw::WindowConfig& w = j.firmware.gyro.windows;
   w.rotate_on_static_base = true;
   w.min_windows_per_bin = 1;
   w.windows_per_bin = 2;
@@ -183,26 +162,18 @@ JobConfig static_base_job(double duration_s) {
   return j;
 }
 
-void derive_firmware_config(JobConfig& j) {
-  // The chain learns the converters from the simulated board's configuration
-  // (ADC full scale 2.5 V there, 2.0 V in the chain's defaults).
-  fw::ConverterInfo conv;
-  conv.sample_rate_hz = j.sim.adc.sample_rate_hz;
-  conv.block_frames = j.sim.adc.block_frames;
-  conv.adc_full_scale_v = j.sim.adc.full_scale_v;
-  conv.dac_full_scale_v = j.sim.dac.full_scale_v;
-  conv.dac_latency_samples = j.sim.dac.latency_samples;
-  j.chain = fw::chain_config_for(conv, j.chain);
-  dsp::ChainConfig& c = j.chain;
-  c.amplitude_setpoint_v = j.gyro.amplitude_set_v;
-  j.estimator.angular_gain = j.gyro.angular_gain;
-  // The pump's gap part of D_Phi is used only once the pattern angles seen
-  // with the excitation on make its 3x3 fit well conditioned: an early fit
-  // from a few nearby angles adds more than it removes (default run: ADB
-  // 2.5 deg/h at the estimator's default 1e3, 0.15 deg/h at 10).
-  j.estimator.pump.max_kappa_2 = 10.0;
-  j.gyro.monitor.amplitude_set_v = j.gyro.amplitude_set_v;
+fw::ConverterLayout converter_layout(const sim::SimConfig& sim) {
+  // ADC full scale 2.5 V on the simulated board, 2.0 V in the chain's defaults.
+  fw::ConverterLayout conv;
+  conv.sample_rate_hz = sim.adc.sample_rate_hz;
+  conv.block_frames = sim.adc.block_frames;
+  conv.adc_full_scale_v = sim.adc.full_scale_v;
+  conv.dac_full_scale_v = sim.dac.full_scale_v;
+  conv.dac_latency_samples = sim.dac.latency_samples;
+  return conv;
 }
+
+void derive_firmware_config(JobConfig& j) { fw::app::derive(j.firmware, converter_layout(j.sim)); }
 
 namespace {
 
@@ -253,11 +224,11 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const sim
   row.true_theta_deg = ts.pattern_angle_rad / kDeg;
   row.a_a_v = st.chain.a_a_v;
   row.a_b_v = st.chain.a_b_v;
-  row.drift_model_dph = st.drift_rad_s / job.gyro.angular_gain * kRadSToDph;
-  row.drift_control_dph = st.control_drift_rad_s / job.gyro.angular_gain * kRadSToDph;
+  row.drift_model_dph = st.drift_rad_s / job.firmware.gyro.angular_gain * kRadSToDph;
+  row.drift_control_dph = st.control_drift_rad_s / job.firmware.gyro.angular_gain * kRadSToDph;
   const double q = ts.a_a_v > 0 ? ts.a_b_v / ts.a_a_v : 0.0;
   row.drift_true_dph = true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) /
-                       job.gyro.angular_gain * kRadSToDph;
+                       job.firmware.gyro.angular_gain * kRadSToDph;
   row.out_valid = st.out_valid ? 1 : 0;
   row.pattern_cmd = st.pattern_control ? 1 : 0;
   r.rows.push_back(row);
@@ -385,12 +356,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   JobResult r;
   const bool progress = opt.progress;
   const std::string& can_log = opt.can_log;
-  fw::DspChainPort chain(job.chain);
-  if (const char* err = chain.error())
-    throw std::invalid_argument(std::string("signal chain configuration: ") + err);
   sim::SimTarget& target = sim::target();
   target.configure(job.sim);
-  fw::EstimatorPort ident(job.estimator);
   // Lockstep: the board's simulated clock paces (it returns at once) and a
   // host clock times the tasks. Real time: CLOCK_MONOTONIC does both, with
   // the simulated converters behind it.
@@ -407,16 +374,18 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     r.realtime_setup =
         hal::linux_board::describe(hal::linux_board::setup_realtime(req), buf, sizeof buf);
   }
-  // The firmware objects are large (the chain holds its filters): on the heap
-  // here, statically allocated on a board.
-  auto gyro = opt.real_time ? std::make_unique<fw::Gyro>(rt_board, chain, ident, rt_clock,
-                                                         fw::Pacing::real_time, job.gyro)
-                            : std::make_unique<fw::Gyro>(sim_board, chain, ident, host_timer,
-                                                         fw::Pacing::lockstep, job.gyro);
-  if (!gyro->board_ok())
-    throw std::invalid_argument(
-        "the simulated board's converters do not "
-        "match the firmware's block layout");
+  // The firmware is large (the chain holds its filters): on the heap here,
+  // statically allocated on a board.
+  auto firmware = opt.real_time ? std::make_unique<fw::app::Firmware>(
+                                      rt_board, rt_clock, fw::Pacing::real_time, job.firmware)
+                                : std::make_unique<fw::app::Firmware>(
+                                      sim_board, host_timer, fw::Pacing::lockstep, job.firmware);
+  if (const char* err = firmware->chain().error())
+    throw std::invalid_argument(std::string("signal chain configuration: ") + err);
+  if (const char* err = firmware->error()) throw std::invalid_argument(err);
+  fw::Gyro* gyro = &firmware->gyro();
+  const fw::DspChainPort& chain = firmware->chain();
+  const fw::EstimatorPort& ident = firmware->estimator();
   std::unique_ptr<can::CandumpLogWriter> log;
   if (!can_log.empty()) log = std::make_unique<can::CandumpLogWriter>(can_log, "can0");
 
@@ -438,9 +407,9 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   // A row is free of any drive once the last driven DAC word (played
   // dac_lead_frames + the DAC's pipeline latency after its block) lies before
   // the 3 L - 2 samples the demodulator averages: exc = 0 only from then on.
-  const double block_frames = static_cast<double>(job.chain.block_frames);
+  const double block_frames = static_cast<double>(job.firmware.chain.block_frames);
   const auto drive_free_blocks =
-      static_cast<uint64_t>(1.0 + std::ceil((job.chain.dac_lead_frames +
+      static_cast<uint64_t>(1.0 + std::ceil((job.firmware.chain.dac_lead_frames +
                                              static_cast<double>(job.sim.dac.latency_samples) +
                                              2.0 * block_frames - 2.0) /
                                             block_frames));
@@ -467,7 +436,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       // NCO phase at the first sample after this block (time t_s) against the
       // fixed reference 2 pi f_ref t.
       const double nco_cycles = static_cast<double>(chain.chain().nco_phase()) * 0x1p-32;
-      const double ref_cycles = std::fmod(job.chain.f_center_hz * st.chain.t_s, 1.0);
+      const double ref_cycles = std::fmod(job.firmware.chain.f_center_hz * st.chain.t_s, 1.0);
       ref_offset_hist[2] = ref_offset_hist[1];
       ref_offset_hist[1] = ref_offset_hist[0];
       ref_offset_hist[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
@@ -560,7 +529,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   const double adc_sigma_v =
       std::sqrt(0.5 * (job.sim.adc.noise_v_rms[0] * job.sim.adc.noise_v_rms[0] +
                        job.sim.adc.noise_v_rms[1] * job.sim.adc.noise_v_rms[1]));
-  r.noise_sigma_v = adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.chain.block_frames));
+  r.noise_sigma_v =
+      adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.firmware.chain.block_frames));
   const est::ParamMatrix crb = ident.estimator().cramer_rao_bound(r.noise_sigma_v);
   for (int i = 0; i < est::kParams; ++i) {
     r.crb_sigma[static_cast<std::size_t>(i)] = crb(i, i) > 0.0 ? std::sqrt(crb(i, i)) : 0.0;

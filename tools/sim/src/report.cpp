@@ -247,8 +247,8 @@ std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobCon
 
 void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r) {
   // Streamed row by row: an hour of telemetry is not held twice in memory.
-  recording::RecordingWriter wr(path, telemetry_columns(), job.chain.f_center_hz,
-                                job.gyro.angular_gain, telemetry_metadata(job));
+  recording::RecordingWriter wr(path, telemetry_columns(), job.firmware.chain.f_center_hz,
+                                job.firmware.gyro.angular_gain, telemetry_metadata(job));
   std::vector<double> v;
   for (const Row& row : r.rows) {
     telemetry_values(row, v);
@@ -258,7 +258,8 @@ void write_telemetry(const std::filesystem::path& path, const JobConfig& job, co
 }
 
 recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r) {
-  recording::Recording rec(telemetry_columns(), job.chain.f_center_hz, job.gyro.angular_gain);
+  recording::Recording rec(telemetry_columns(), job.firmware.chain.f_center_hz,
+                           job.firmware.gyro.angular_gain);
   for (const auto& [key, value] : telemetry_metadata(job))
     rec.set_metadata(key, value);
   std::vector<double> v;

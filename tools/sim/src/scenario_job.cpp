@@ -28,17 +28,17 @@ JobConfig job_from_scenario(const std::string& path, double duration_s, int bias
     job.sweep_end_s = job.duration_s;
     job.earth_rate_rad_s = 0.0;
   }
-  job.gyro.angular_gain = sc.resonator.angular_gain;
+  job.firmware.gyro.angular_gain = sc.resonator.angular_gain;
   derive_firmware_config(job);
-  job.chain.f_center_hz = sc.resonator.f_hz;
-  job.chain.f_min_hz = sc.resonator.f_hz - 10.0;
-  job.chain.f_max_hz = sc.resonator.f_hz + 10.0;
-  job.chain.q_factor = sc.resonator.q;
-  job.chain.pump_gain_per_s2_v2 = sc.electrodes.pump_gain_per_s2_v2;
-  job.chain.forcer_gain_per_s2 = sc.electrodes.forcer_gain_per_s2;
+  job.firmware.chain.f_center_hz = sc.resonator.f_hz;
+  job.firmware.chain.f_min_hz = sc.resonator.f_hz - 10.0;
+  job.firmware.chain.f_max_hz = sc.resonator.f_hz + 10.0;
+  job.firmware.chain.q_factor = sc.resonator.q;
+  job.firmware.chain.pump_gain_per_s2_v2 = sc.electrodes.pump_gain_per_s2_v2;
+  job.firmware.chain.forcer_gain_per_s2 = sc.electrodes.forcer_gain_per_s2;
   // The PLL range above (+-10 Hz about the resonance) and the converters
   // must still make a usable chain (e.g. the NCO's periodicity rule).
-  if (const char* err = dsp::check_chain_config(job.chain))
+  if (const char* err = dsp::check_chain_config(job.firmware.chain))
     throw std::invalid_argument("scenario " + path + ": signal chain configuration: " + err);
   return job;
 }

@@ -6,9 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "dsp/chain.hpp"
-#include "estimator/estimator.hpp"
-#include "firmware/gyro.hpp"
+#include "firmware/app/firmware_config.hpp"
 #include "sim_target/sim_config.hpp"
 #include "sim_tools/analysis.hpp"
 
@@ -34,9 +32,7 @@ struct FaultEvent {
 // parts, the input schedule and what to record.
 struct JobConfig {
   sim::SimConfig sim;
-  fw::GyroConfig gyro;
-  dsp::ChainConfig chain;
-  est::Estimator::Config estimator;
+  fw::app::FirmwareConfig firmware;  // derived from `sim` by derive_firmware_config
   double duration_s = 0.0;
   double latitude_deg = 55.75;
   double earth_rate_rad_s = 0.0;   // vertical component of the Earth rate in the input
@@ -61,8 +57,12 @@ JobConfig default_job(double duration_s, int bias_angles = 16);
 // output is held while the pattern is moved. Default length 300 s.
 JobConfig static_base_job(double duration_s);
 
-// Fills the firmware-side configuration (chain converters, estimator K) from
-// the simulated board, so that a scenario only has to describe the target.
+// The simulated board's converter layout, as the firmware's chain must know it.
+fw::ConverterLayout converter_layout(const sim::SimConfig& sim);
+
+// Fills the firmware's derived fields (chain converters, K and the set point
+// where they are copied) from the simulated board and `job.firmware.gyro`, so
+// that a scenario only has to describe the target.
 void derive_firmware_config(JobConfig& job);
 
 // One telemetry row (the recording's columns plus the truth).

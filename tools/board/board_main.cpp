@@ -17,11 +17,8 @@
 #include <memory>
 #include <string>
 
+#include "firmware/app/firmware.hpp"
 #include "firmware/can/link.hpp"
-#include "firmware/can/telemetry.hpp"
-#include "firmware/dsp_chain_port.hpp"
-#include "firmware/estimator_port.hpp"
-#include "firmware/gyro.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
@@ -115,15 +112,14 @@ int main(int argc, char** argv) {
 
   char rt[200];
   std::printf("hrg-board: %s\n", lb::describe(lb::setup_realtime({}), rt, sizeof rt));
-  // Large objects (the chain holds its filters): allocated once, before the loop.
-  auto chain = std::make_unique<fw::DspChainPort>(job.chain);
-  auto ident = std::make_unique<fw::EstimatorPort>(job.estimator);
-  auto gyro =
-      std::make_unique<fw::Gyro>(board, *chain, *ident, clock, fw::Pacing::real_time, job.gyro);
-  if (!gyro->board_ok()) {
-    std::fprintf(stderr, "hrg-board: converters do not match the firmware's block layout\n");
+  // Large (the chain holds its filters): allocated once, before the loop.
+  auto firmware =
+      std::make_unique<fw::app::Firmware>(board, clock, fw::Pacing::real_time, job.firmware);
+  if (const char* err = firmware->error()) {
+    std::fprintf(stderr, "hrg-board: %s\n", err);
     return 1;
   }
+  fw::Gyro* gyro = &firmware->gyro();
   // The firmware's command task receives and answers commands itself; the
   // board adds the command filter and the bus-off restart policy.
   fw::can::CanLink link(can, fw::kBaseRateHz / 10);

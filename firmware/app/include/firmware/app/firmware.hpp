@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "firmware/app/firmware_config.hpp"
+#include "firmware/dsp_chain_port.hpp"
+#include "firmware/estimator_port.hpp"
+#include "firmware/gyro.hpp"
+#include "hal/board.hpp"
+
+namespace hrg::fw::app {
+
+// The firmware assembled on a board: the signal chain over dsp::Chain, the
+// estimator and the gyro (executive, modes, windows, output, CAN) that runs
+// them. The only place where the parts are put together; the main job
+// (hrg sim), hrg-board and the audit's firmware campaign all build this.
+// Large (the chain holds its filters): a board places it statically, a host
+// on the heap. Allocates nothing itself.
+class Firmware {
+ public:
+  // `timer` times the tasks (the board clock in real time, a host clock in
+  // lockstep).
+  Firmware(hal::Board& board, hal::MonotonicClock& timer, Pacing pacing, const FirmwareConfig& cfg)
+      : cfg_(cfg),
+        chain_(cfg.chain),
+        estimator_(cfg.estimator),
+        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {}
+  Firmware(const Firmware&) = delete;
+  Firmware& operator=(const Firmware&) = delete;
+
+  // nullptr when the firmware can drive the resonator, else why it keeps the
+  // drives off (an unusable chain configuration, a board whose converters
+  // do not match the firmware's block layout).
+  const char* error() const {
+    if (const char* e = chain_.error()) return e;
+    return gyro_.board_ok() ? nullptr
+                            : "the board's converters do not match the firmware's block layout";
+  }
+
+  void run_frame() { gyro_.run_frame(); }
+  Gyro& gyro() { return gyro_; }
+  const Gyro& gyro() const { return gyro_; }
+  const DspChainPort& chain() const { return chain_; }
+  const EstimatorPort& estimator() const { return estimator_; }
+  const FirmwareConfig& config() const { return cfg_; }
+
+ private:
+  FirmwareConfig cfg_;
+  DspChainPort chain_;
+  EstimatorPort estimator_;
+  Gyro gyro_;
+};
+
+}  // namespace hrg::fw::app

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "dsp/chain.hpp"
+#include "estimator/estimator.hpp"
+#include "firmware/dsp_chain_port.hpp"
+#include "firmware/gyro.hpp"
+
+namespace hrg::fw::app {
+
+// The firmware's whole configuration: the executive's (windows, bands,
+// monitors), the signal chain's and the estimator's. K (`gyro.angular_gain`)
+// and the AGC set point (`gyro.amplitude_set_v`) are set in `gyro` only;
+// derive() copies them, and the converter layout, to the parts that need
+// them. Change them there and call derive() again.
+struct FirmwareConfig {
+  GyroConfig gyro;
+  dsp::ChainConfig chain;
+  est::Estimator::Config estimator;
+};
+
+// How the free-decay windows identify the resonator.
+enum class WindowPlan : uint8_t {
+  // 1 s windows every 2 s, 4 per 4 theta bin (2 at least): the main job's
+  // few-minute runs.
+  standard,
+  // 5 s windows every 10 s, 4 per bin, all required: runs of an hour or more
+  // with an identification phase of their own.
+  long_run,
+};
+
+// The firmware's defaults for a board with this converter layout, derived.
+FirmwareConfig default_firmware_config(const ConverterLayout& conv,
+                                       WindowPlan plan = WindowPlan::standard);
+
+// Sets the window plan's fields of `w` (the others are left alone).
+void apply_window_plan(WindowConfig& w, WindowPlan plan);
+
+// Fills the derived fields: the chain's converter fields from `conv`, and K
+// and the set point from `cfg.gyro` into the chain, the estimator and the
+// monitor.
+void derive(FirmwareConfig& cfg, const ConverterLayout& conv);
+
+}  // namespace hrg::fw::app

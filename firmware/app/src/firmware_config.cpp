@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/app/firmware_config.hpp"
+
+namespace hrg::fw::app {
+
+void apply_window_plan(WindowConfig& w, WindowPlan plan) {
+  if (plan == WindowPlan::long_run) {
+    // 4 windows of 5 s per 4 theta bin while the table turns (64 windows,
+    // 320 s: 8.9 % of an hour), 10 s apart so the AGC is back at the set
+    // point between them; each carries 125 times the decay information of a
+    // 1 s window. The campaign ends only when every bin has its 4.
+    w.length_frames = 5000;
+    w.period_frames = 10000;
+    w.max_wait_frames = 20000;
+    w.windows_per_bin = 4;
+    w.min_windows_per_bin = 4;
+    return;
+  }
+  // Long windows: the decay-rate information of one window grows as T^3
+  // (slope of a noisy line), so one 1 s window is worth about 20 windows of
+  // 130 ms for a quarter of the excitation-off time.
+  w.length_frames = 1000;
+  w.period_frames = 2000;
+  w.max_wait_frames = 10000;
+  w.windows_per_bin = 4;
+  w.min_windows_per_bin = 2;
+}
+
+FirmwareConfig default_firmware_config(const ConverterLayout& conv, WindowPlan plan) {
+  FirmwareConfig f;
+  GyroConfig& g = f.gyro;
+  g.amplitude_set_v = 1.0;
+  WindowConfig& w = g.windows;
+  w.bins = 16;
+  w.condition_good = 50.0;
+  w.coverage_good = 1.0;
+  apply_window_plan(w, plan);
+  // The pump's gap part of D_Phi is used only once the pattern angles seen
+  // with the excitation on make its 3x3 fit well conditioned: an early fit
+  // from a few nearby angles adds more than it removes (default run: ADB
+  // 2.5 deg/h at the estimator's default 1e3, 0.15 deg/h at 10).
+  f.estimator.pump.max_kappa_2 = 10.0;
+  derive(f, conv);
+  return f;
+}
+
+void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
+  cfg.chain = chain_config_for(conv, cfg.chain);
+  cfg.chain.amplitude_setpoint_v = cfg.gyro.amplitude_set_v;
+  cfg.gyro.monitor.amplitude_set_v = cfg.gyro.amplitude_set_v;
+  cfg.estimator.angular_gain = cfg.gyro.angular_gain;
+}
+
+}  // namespace hrg::fw::app
