@@ -9,7 +9,16 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 double clamp_abs(double v, double lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
+double wrap_pi(double a) { return a - 2.0 * kPi * std::round(a / (2.0 * kPi)); }
 }  // namespace
+
+double pump_phase_error_rad(double prev_pump_phase_rad, double wave_phase_rad) {
+  return wrap_pi(kPi / 2.0 - 2.0 * (prev_pump_phase_rad - wave_phase_rad));
+}
+
+double quad_force_rate_v_s(double forcer_gain_per_s2, double w_rad_s, double u_q_v) {
+  return forcer_gain_per_s2 / (2.0 * w_rad_s) * u_q_v;
+}
 
 const char* check_chain_config(const ChainConfig& c) {
   if (!(c.sample_rate_hz > 0.0)) return "chain config: sample_rate_hz must be > 0";
@@ -85,6 +94,7 @@ void Chain<T>::reset() {
   step_ = phase_step_of_hz(cfg_.f_center_hz, cfg_.sample_rate_hz);
   pump_on_ = forcers_on_ = false;
   ring_up_ = true;
+  have_pump_phase_ = false;
   wave_phase_rad_ = 0.0;
   c2_ = std::cos(2.0 * cfg_.ring_up_theta_rad);
   s2_ = std::sin(2.0 * cfg_.ring_up_theta_rad);
@@ -100,9 +110,13 @@ void Chain<T>::set_pattern_command(bool enabled, double theta_target_rad, double
 
 template <typename T>
 bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
+  // A refused block breaks the pump phase history (the next error is 0).
+  const bool had_pump_phase = have_pump_phase_;
+  have_pump_phase_ = false;
   if (!usable_) return false;
-  if (adc.size() != kChainAdcChannels * cfg_.block_frames) return false;
-  if (dac.size() != kChainDacChannels * cfg_.block_frames) return false;
+  if (adc.size() != kChainAdcChannels * cfg_.block_frames ||
+      dac.size() != kChainDacChannels * cfg_.block_frames)
+    return false;
 
   const uint32_t phase_block_start = phase_;
   QuadSample<T> qs;
@@ -118,7 +132,10 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
   out_.phase_err_rad = w.phase_rad;
 
   const double dt_s = static_cast<double>(cfg_.block_frames) / cfg_.sample_rate_hz;
+  const double prev_pump_phase_rad = out_.pump_phase_rad;
   update_loops(w, dt_s);
+  update_drift_inputs(had_pump_phase, prev_pump_phase_rad);
+  have_pump_phase_ = true;
   step_ = phase_step_of_hz(out_.pll_freq_hz, cfg_.sample_rate_hz);
   synthesize(phase_block_start, dac);
   ++out_.blocks;
@@ -178,6 +195,21 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
   out_.quad_effort_v = u_q_v_;
   out_.pattern_effort_v = u_r_v_;
   out_.ring_up_drive_v = u_a_v_;
+}
+
+template <typename T>
+void Chain<T>::update_drift_inputs(bool had_pump_phase, double prev_pump_phase_rad) {
+  out_.quad_effort = cfg_.forcer_max_v > 0.0 ? u_q_v_ / cfg_.forcer_max_v : 0.0;
+  // Only the pump's phase offset away from the ideal quarter turn counts.
+  if (had_pump_phase && out_.pump_v > 0.0) {
+    const double phi_a = out_.pump_phase_rad - cfg_.pump_phase_rad;  // this block's wave phase
+    out_.pump_phase_error_rad = pump_phase_error_rad(prev_pump_phase_rad, phi_a);
+  } else {
+    out_.pump_phase_error_rad = 0.0;
+  }
+  const double f_hz = out_.pll_freq_hz > 0.0 ? out_.pll_freq_hz : cfg_.f_center_hz;
+  out_.quad_force_sin_v_s = quad_force_rate_v_s(cfg_.forcer_gain_per_s2, 2.0 * kPi * f_hz, u_q_v_);
+  out_.quad_force_cos_v_s = 0.0;
 }
 
 template <typename T>

@@ -9,8 +9,6 @@ namespace hrg::fw {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
-
-double wrap_pi(double a) { return a - 2.0 * kPi * std::round(a / (2.0 * kPi)); }
 }  // namespace
 
 dsp::ChainConfig chain_config_for(const ConverterLayout& conv, dsp::ChainConfig base) {
@@ -47,8 +45,8 @@ DspChainPort::DspChainPort(const dsp::ChainConfig& cfg, double pattern_max_rate_
       pattern_max_rate_rad_s > 0.0 ? std::min(pattern_max_rate_rad_s, limit) : limit;
 }
 
-void DspChainPort::process(std::span<const hal::sample_q31> adc, std::span<hal::sample_q31> dac,
-                           const ChainCommands& cmd, ChainOutputs& out) {
+void DspChainPort::process(std::span<const hal::q31_t> adc, std::span<hal::q31_t> dac,
+                           const ChainCommands& cmd, ChainRecord& out) {
   if (error_ == nullptr) {
     // Each drive separately: a mode may allow the forcers (ring-up, pattern
     // moves) without the pump, or the reverse.
@@ -63,43 +61,9 @@ void DspChainPort::process(std::span<const hal::sample_q31> adc, std::span<hal::
     for (auto& w : dac)
       w = 0;
     out.locked = false;
-    have_pump_phase_ = false;
     return;
   }
-  const dsp::ChainOutputs& o = chain_.outputs();
-  const dsp::ChainConfig& c = chain_.config();
-  out.cx_v = o.quad.cx;
-  out.sx_v = o.quad.sx;
-  out.cy_v = o.quad.cy;
-  out.sy_v = o.quad.sy;
-  out.e_v2 = o.wave.E;
-  out.a_a_v = o.wave.a_A;
-  out.a_b_v = o.wave.a_B;
-  out.theta_a_rad = o.theta_A_rad;  // unwrapped by the chain
-  out.f_ref_hz = o.pll_freq_hz;
-  out.pump_v = o.pump_v;
-  out.quad_effort = c.forcer_max_v > 0.0 ? o.quad_effort_v / c.forcer_max_v : 0.0;
-  // The pump acting during this block was set from the previous block's
-  // wave phase; against the wave phase measured now its error is
-  // eps = pi/2 - 2 (phi_V - phi_A), phi_V - phi_A ideally pump_phase_rad.
-  // Only the phase offset away from the ideal quarter turn counts.
-  if (have_pump_phase_ && o.pump_v > 0.0) {
-    const double phi_a = o.pump_phase_rad - c.pump_phase_rad;  // this block's wave phase
-    out.pump_phase_error_rad = wrap_pi(kPi / 2.0 - 2.0 * (last_pump_phase_rad_ - phi_a));
-  } else {
-    out.pump_phase_error_rad = 0.0;
-  }
-  last_pump_phase_rad_ = o.pump_phase_rad;
-  have_pump_phase_ = true;
-  // Forcer actions (chain.hpp): the quadrature drive u_q changes a_B at
-  // g u_q / (2 w), synthesized in phase with wave A's displacement, so it
-  // has no commanded part on the angle. The pattern drive is not a control
-  // error (it turns the pattern on purpose, with the output held) and is
-  // left out.
-  const double w_rad_s = 2.0 * kPi * (o.pll_freq_hz > 0.0 ? o.pll_freq_hz : c.f_center_hz);
-  out.quad_sin_v_s = c.forcer_gain_per_s2 / (2.0 * w_rad_s) * o.quad_effort_v;
-  out.quad_cos_v_s = 0.0;
-  out.locked = o.locked;
+  static_cast<dsp::ChainOutputs&>(out) = chain_.outputs();
 }
 
 }  // namespace hrg::fw

@@ -7,13 +7,13 @@ namespace hrg::fw {
 
 void EstimatorPort::begin_window(double t_s) { (void)est_.begin_window(t_s); }
 
-void EstimatorPort::add_sample(const ChainOutputs& s) {
+void EstimatorPort::add_sample(const ChainRecord& s) {
   est::WaveSample w;
   w.t_s = s.t_s;
-  w.a_A_v = s.a_a_v;
-  w.a_B_v = s.a_b_v;
-  w.theta_A_rad = s.theta_a_rad;
-  w.E_v2 = s.e_v2;
+  w.a_A_v = s.wave.a_A;
+  w.a_B_v = s.wave.a_B;
+  w.theta_A_rad = s.theta_A_rad;
+  w.E_v2 = s.wave.E;
   // Settling samples and sequencing errors are the accumulator's to count.
   (void)est_.add_sample(w);
 }
@@ -35,18 +35,18 @@ void EstimatorPort::abort_window() {
   ++windows_bad_;
 }
 
-void EstimatorPort::add_control_sample(const ChainOutputs& s) {
+void EstimatorPort::add_control_sample(const ChainRecord& s) {
   // The D_Phi fits take the identified decay and split as known: before a
   // model is accepted they would fold in a wrong one.
   if (!est_.has_model()) return;
   est::ControlDriftEstimator::Sample c;
   c.t_s = s.t_s;
-  c.a_A_v = s.a_a_v;
-  c.a_B_v = s.a_b_v;
-  c.theta_A_rad = s.theta_a_rad;
+  c.a_A_v = s.wave.a_A;
+  c.a_B_v = s.wave.a_B;
+  c.theta_A_rad = s.theta_A_rad;
   c.pump_phase_error_rad = s.pump_phase_error_rad;
-  c.quad_force_sin_v_s = s.quad_sin_v_s;
-  c.quad_force_cos_v_s = s.quad_cos_v_s;
+  c.quad_force_sin_v_s = s.quad_force_sin_v_s;
+  c.quad_force_cos_v_s = s.quad_force_cos_v_s;
   c.pump_v = s.pump_v;
   // Samples are taken every control period in operate; a gap (a window, a
   // commanded pattern move) ends the derivative blocks first.

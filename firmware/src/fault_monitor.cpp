@@ -35,10 +35,10 @@ uint16_t FaultMonitor::update(const MonitorInputs& in, Mode mode) {
   return bits;
 }
 
-bool adc_block_stuck(std::span<const hal::sample_q31> frames, std::size_t channels) {
+bool adc_block_stuck(std::span<const hal::q31_t> frames, std::size_t channels) {
   if (channels == 0 || frames.size() < 2 * channels) return false;
   for (std::size_t c = 0; c < channels; ++c) {
-    const hal::sample_q31 first = frames[c];
+    const hal::q31_t first = frames[c];
     bool same = true;
     for (std::size_t i = c + channels; i < frames.size(); i += channels) {
       if (frames[i] != first) {

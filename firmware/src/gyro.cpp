@@ -86,14 +86,14 @@ void Gyro::task_chain(Gyro& g) {
 }
 
 bool Gyro::in_bands() const {
-  const ChainOutputs& o = status_.chain;
-  if (!o.locked || cfg_.amplitude_set_v <= 0.0 || o.a_a_v <= 0.0) return false;
-  const double amp_err = std::fabs(o.a_a_v - cfg_.amplitude_set_v) / cfg_.amplitude_set_v;
-  return amp_err < cfg_.amplitude_band && std::fabs(o.a_b_v / o.a_a_v) < cfg_.quadrature_band;
+  const ChainRecord& o = status_.chain;
+  if (!o.locked || cfg_.amplitude_set_v <= 0.0 || o.wave.a_A <= 0.0) return false;
+  const double amp_err = std::fabs(o.wave.a_A - cfg_.amplitude_set_v) / cfg_.amplitude_set_v;
+  return amp_err < cfg_.amplitude_band && std::fabs(o.wave.a_B / o.wave.a_A) < cfg_.quadrature_band;
 }
 
 void Gyro::step_mode_progress(const WindowDecision& d) {
-  const ChainOutputs& o = status_.chain;
+  const ChainRecord& o = status_.chain;
   switch (mode_.mode()) {
     case Mode::power_up:
       if (board_ok_ && ++progress_frames_ >= cfg_.self_test_frames) {
@@ -101,7 +101,7 @@ void Gyro::step_mode_progress(const WindowDecision& d) {
       }
       break;
     case Mode::ring_up:
-      if (o.a_a_v >= (1.0 - cfg_.amplitude_band) * cfg_.amplitude_set_v) {
+      if (o.wave.a_A >= (1.0 - cfg_.amplitude_band) * cfg_.amplitude_set_v) {
         mode_.handle(Event::amplitude_reached);
       }
       break;
@@ -132,7 +132,7 @@ void Gyro::task_supervise(Gyro& g) {
   (void)g.board_.fault_input.read(fault_in);
   g.status_.fault_input = fault_in;
   MonitorInputs in;
-  in.amplitude_v = g.status_.chain.a_a_v;
+  in.amplitude_v = g.status_.chain.wave.a_A;
   in.pll_locked = g.status_.chain.locked;
   in.adc_clipped = g.adc_clipped_;
   in.adc_samples = static_cast<uint32_t>(g.adc_.size());
@@ -201,7 +201,7 @@ void Gyro::task_identify(Gyro& g) {
 }
 
 void Gyro::task_output(Gyro& g) {
-  const ChainOutputs& o = g.status_.chain;
+  const ChainRecord& o = g.status_.chain;
   // The output is held while the pattern is moved on purpose, and for a
   // short time after (the demodulator still shows the end of the move).
   const bool moving_on_purpose = g.status_.pattern_control || g.pattern_hold_frames_ > 0;
@@ -211,7 +211,7 @@ void Gyro::task_output(Gyro& g) {
     --g.pattern_hold_frames_;
   }
   if (moving_on_purpose) g.output_.rereference();
-  const double ratio = o.a_a_v > 0.0 ? o.a_b_v / o.a_a_v : 0.0;
+  const double ratio = o.wave.a_A > 0.0 ? o.wave.a_B / o.wave.a_A : 0.0;
   // The model is applied once the campaign has ended (conditioning and
   // coverage good): an early solution from a few windows at nearby angles
   // would add more error than it removes.
@@ -219,18 +219,18 @@ void Gyro::task_output(Gyro& g) {
     g.compensation_ready_ = true;
   }
   double drift = g.cfg_.compensate_drift && g.compensation_ready_
-                     ? g.identifier_.drift_rad_s(o.theta_a_rad, ratio)
+                     ? g.identifier_.drift_rad_s(o.theta_A_rad, ratio)
                      : 0.0;
   // The control loops drift the pattern only while they drive it.
   double control = 0.0;
   if (g.cfg_.compensate_drift && g.cfg_.compensate_control_drift && g.compensation_ready_ &&
       g.status_.excitation_on) {
-    control = g.identifier_.control_drift_rad_s(o.theta_a_rad);
+    control = g.identifier_.control_drift_rad_s(o.theta_A_rad);
   }
   drift += control;
   g.status_.control_drift_rad_s = control;
   const bool valid = g.mode_.permissions().output_valid && !moving_on_purpose;
-  g.output_.update(o.theta_a_rad, drift, valid);
+  g.output_.update(o.theta_A_rad, drift, valid);
   GyroStatus& s = g.status_;
   s.drift_rad_s = drift;
   s.theta_unwrapped_rad = g.output_.theta_unwrapped_rad();
@@ -247,13 +247,13 @@ void Gyro::task_solve(Gyro& g) {
 void Gyro::task_telemetry(Gyro& g) {
   const GyroStatus& st = g.status_;
   can::TelemetrySnapshot& s = g.snapshot_;
-  s.cx_v = st.chain.cx_v;
-  s.sx_v = st.chain.sx_v;
-  s.cy_v = st.chain.cy_v;
-  s.sy_v = st.chain.sy_v;
+  s.cx_v = st.chain.quad.cx;
+  s.sx_v = st.chain.quad.sx;
+  s.cy_v = st.chain.quad.cy;
+  s.sy_v = st.chain.quad.sy;
   s.theta_a_rad = st.theta_unwrapped_rad;
   s.output_angle_rad = st.out_angle_rad;
-  s.pll_freq_hz = st.chain.f_ref_hz;
+  s.pll_freq_hz = st.chain.pll_freq_hz;
   s.pll_locked = st.chain.locked;
   s.quad_effort = st.chain.quad_effort;
   s.pump_v = st.chain.pump_v;

@@ -20,7 +20,7 @@ AdcQuantizer::AdcQuantizer(const AdcConfig& c)
       lsb_v_(c.full_scale_v / std::ldexp(1.0, static_cast<int>(c.bits) - 1)),
       code_max_((int64_t{1} << (c.bits - 1)) - 1) {}
 
-hal::sample_q31 AdcQuantizer::convert(double v, bool& clipped) const {
+hal::q31_t AdcQuantizer::convert(double v, bool& clipped) const {
   const double scaled = std::nearbyint(v / lsb_v_);
   int64_t code = 0;
   clipped = false;
@@ -33,10 +33,10 @@ hal::sample_q31 AdcQuantizer::convert(double v, bool& clipped) const {
   } else {
     code = static_cast<int64_t>(scaled);
   }
-  return static_cast<hal::sample_q31>(code * (int64_t{1} << (32 - bits_)));
+  return static_cast<hal::q31_t>(code * (int64_t{1} << (32 - bits_)));
 }
 
-double AdcQuantizer::to_volts(hal::sample_q31 word) const {
+double AdcQuantizer::to_volts(hal::q31_t word) const {
   return static_cast<double>(word) * 0x1.0p-31 * full_scale_v_;
 }
 
@@ -45,17 +45,17 @@ DacQuantizer::DacQuantizer(const DacConfig& c)
       full_scale_v_(c.full_scale_v),
       code_max_((int64_t{1} << (c.bits - 1)) - 1) {}
 
-double DacQuantizer::convert(hal::sample_q31 word, bool& saturated) const {
+double DacQuantizer::convert(hal::q31_t word, bool& saturated) const {
   const int64_t code = static_cast<int64_t>(word) >> (32 - bits_);
   saturated = code >= code_max_ || code <= -code_max_ - 1;
   return static_cast<double>(code) / static_cast<double>(code_max_ + 1) * full_scale_v_;
 }
 
-hal::sample_q31 DacQuantizer::word_for(double v) const {
+hal::q31_t DacQuantizer::word_for(double v) const {
   const double code =
       std::clamp(std::nearbyint(v / full_scale_v_ * static_cast<double>(code_max_ + 1)),
                  static_cast<double>(-code_max_ - 1), static_cast<double>(code_max_));
-  return static_cast<hal::sample_q31>(static_cast<int64_t>(code) * (int64_t{1} << (32 - bits_)));
+  return static_cast<hal::q31_t>(static_cast<int64_t>(code) * (int64_t{1} << (32 - bits_)));
 }
 
 }  // namespace hrg::sim

@@ -134,7 +134,7 @@ Drive SimTarget::next_drive() {
   return Drive{v[0], v[1], v[2]};
 }
 
-Status SimTarget::produce_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                                 uint32_t& clipped) {
   const uint32_t n = config_.adc.block_frames;
   if (frames.size() != static_cast<std::size_t>(n) * hal::kAdcChannels) {
@@ -153,7 +153,7 @@ Status SimTarget::produce_block(std::span<hal::sample_q31> frames, uint64_t& t_f
       const double rms = std::hypot(config_.adc.noise_v_rms[ch], burst);
       if (rms > 0.0) v += rms * noise_.normal();
       bool clip = false;
-      hal::sample_q31 word = adc_q_.convert(v, clip);
+      hal::q31_t word = adc_q_.convert(v, clip);
       if (adc_saturated_[ch]) {
         word = adc_q_.convert(1e300, clip);
       }
@@ -191,7 +191,7 @@ hal::ConverterInfo SimTarget::SimAdc::info() const {
   return {c.sample_rate_hz, c.block_frames, c.full_scale_v};
 }
 
-Status SimTarget::SimAdc::read_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+Status SimTarget::SimAdc::read_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                                      uint32_t& clipped) {
   return t->produce_block(frames, t_first_ns, clipped);
 }
@@ -201,7 +201,7 @@ hal::ConverterInfo SimTarget::SimDac::info() const {
   return {c.adc.sample_rate_hz, c.adc.block_frames, c.dac.full_scale_v};
 }
 
-Status SimTarget::SimDac::write_block(std::span<const hal::sample_q31> frames) {
+Status SimTarget::SimDac::write_block(std::span<const hal::q31_t> frames) {
   const std::size_t n = t->config_.adc.block_frames;
   if (frames.size() != n * hal::kDacChannels) return Status::invalid_argument;
   if (t->dac_queue_.size() - t->dac_head_ >= 4 * n)

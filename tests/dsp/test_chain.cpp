@@ -248,3 +248,47 @@ TEST(Loops, PllStaysWithinItsFrequencyLimits) {
   pll.update(-1.0, true, 1e-3);  // no wind-up: leaves the limit at once
   CHECK(pll.frequency_hz() < 5001.0);
 }
+
+TEST_GROUP(ChainDriftInputs){};
+
+TEST(ChainDriftInputs, PumpPhaseErrorIsZeroAtTheQuarterTurnAndWrapsIntoPlusMinusPi) {
+  const double pi = std::numbers::pi;
+  // eps = pi/2 - 2 (phi_V - phi_A): 0 when the pump leads by pi/4 (a quarter
+  // turn of 2 phi), -2 d when it leads by pi/4 + d.
+  for (double phi : {-3.0, -0.5, 0.0, 1.2, 3.1}) {
+    DOUBLES_EQUAL(0.0, pump_phase_error_rad(phi + pi / 4.0, phi), 1e-12);
+    DOUBLES_EQUAL(-0.2, pump_phase_error_rad(phi + pi / 4.0 + 0.1, phi), 1e-12);
+  }
+  // At the rails: every offset lands in (-pi, pi] and equals eps mod 2 pi.
+  for (double d = -7.0; d <= 7.0; d += 0.25) {
+    const double eps = pump_phase_error_rad(d, 0.0);
+    CHECK(eps > -pi - 1e-12 && eps <= pi + 1e-12);
+    DOUBLES_EQUAL(0.0, std::remainder(eps - (pi / 2.0 - 2.0 * d), 2.0 * pi), 1e-9);
+  }
+  DOUBLES_EQUAL(pi, pump_phase_error_rad(3.0 * pi / 4.0, 0.0), 1e-12);
+}
+
+TEST(ChainDriftInputs, QuadratureForceRateIsGainTimesDriveOverTwoOmega) {
+  // a_B' = g u_q / (2 w): 200 /s^2/V x 1 V / (2 x 2 pi 5 kHz) = 3.183e-3 V/s.
+  const double w = 2.0 * std::numbers::pi * 5000.0;
+  DOUBLES_EQUAL(3.1830988618e-3, quad_force_rate_v_s(200.0, w, 1.0), 1e-13);
+  DOUBLES_EQUAL(-2.0 * 3.1830988618e-3, quad_force_rate_v_s(200.0, w, -2.0), 1e-13);
+  DOUBLES_EQUAL(0.0, quad_force_rate_v_s(200.0, w, 0.0), 0.0);
+}
+
+TEST(ChainDriftInputs, FirstBlockAndPumpOffReportNoPhaseErrorAndEffortIsAFraction) {
+  Chain<q31_t> chain{ChainConfig{}};
+  chain.set_excitation(true);
+  std::vector<q31_t> dac(3 * 100);
+  chain.process(tone_block(100, 5000.0, 0.4, 0.0), dac);
+  DOUBLES_EQUAL(0.0, chain.outputs().pump_phase_error_rad, 0.0);
+  const auto& o = chain.outputs();
+  DOUBLES_EQUAL(o.quad_effort_v / ChainConfig{}.forcer_max_v, o.quad_effort, 1e-15);
+  DOUBLES_EQUAL(quad_force_rate_v_s(ChainConfig{}.forcer_gain_per_s2,
+                                    2.0 * std::numbers::pi * o.pll_freq_hz, o.quad_effort_v),
+                o.quad_force_sin_v_s, 1e-15);
+  DOUBLES_EQUAL(0.0, o.quad_force_cos_v_s, 0.0);
+  chain.set_excitation(false);
+  chain.process(tone_block(100, 5000.0, 0.4, 1e-3), dac);
+  DOUBLES_EQUAL(0.0, chain.outputs().pump_phase_error_rad, 0.0);
+}

@@ -164,6 +164,26 @@ TEST(ClosedLoop, PumpPhaseOfPiOverFourAddsEnergyToWaveA) {
   CHECK(a <= std::exp(-(nu_a + 0.8 * g_max)));
 }
 
+TEST(ClosedLoop, PumpPhaseErrorReportsTheOffsetFromTheQuarterTurn) {
+  // Locked and at the set point, the wave phase against the NCO barely moves
+  // from one block to the next, so the pump phased from the previous block
+  // leads by the configured phi_V - phi_A: eps = pi/2 - 2 phi_V, 0 at pi/4
+  // and -2 d at pi/4 + d (seed sections 6-7).
+  for (double d : {0.0, 0.1, -0.05}) {
+    ChainConfig cfg = rig_config();
+    cfg.pump_phase_rad = kPi / 4 + d;
+    ChainRig<q31_t> rig(cfg);
+    rig.resonator().set_standing_wave(1.0, 0.2);
+    rig.chain().set_excitation(true);
+    rig.run(4.0);
+    double worst = 0.0;
+    rig.run(1.0,
+            [&] { worst = std::fmax(worst, std::fabs(rig.out().pump_phase_error_rad + 2.0 * d)); });
+    CHECK(rig.out().pump_v > 0.0);
+    CHECK(worst < 1e-3);
+  }
+}
+
 TEST(ClosedLoop, LoopsHoldWithPickoffNoise) {
   // GIVEN white pickoff noise of 0.3 mV rms per sample (70 dB below the wave)
   ChainRig<q31_t> rig(rig_config());

@@ -35,7 +35,7 @@ TEST(ChainOnSimTarget, HoldsTheWaveWithThePumpAtItsBestPhase) {
     dsp::Chain<dsp::q31_t> chain(cfg);
     chain.set_excitation(true);
     CHECK(b.excitation_enable.write(true) == hal::Status::ok);
-    std::vector<hal::sample_q31> adc(2 * cfg.block_frames), dac(3 * cfg.block_frames);
+    std::vector<hal::q31_t> adc(2 * cfg.block_frames), dac(3 * cfg.block_frames);
     // WHEN the chain runs for 4 s, block by block
     double worst_a = 0.0, worst_q = 0.0;
     for (int k = 0; k < 4000; ++k) {

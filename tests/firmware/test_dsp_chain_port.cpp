@@ -15,7 +15,7 @@
 
 using hrg::dsp::ChainConfig;
 using hrg::fw::ChainCommands;
-using hrg::fw::ChainOutputs;
+using hrg::fw::ChainRecord;
 using hrg::fw::DspChainPort;
 
 namespace {
@@ -41,7 +41,7 @@ Drive run_blocks(DspChainPort& port, const ChainCommands& cmd, double a_v, doubl
                  int blocks) {
   std::array<int32_t, 2 * kFrames> adc{};
   std::array<int32_t, 3 * kFrames> dac{};
-  ChainOutputs out;
+  ChainRecord out;
   Drive d;
   for (int b = 0; b < blocks; ++b) {
     wave_block(adc, static_cast<uint64_t>(b), a_v, fs_v);

@@ -79,15 +79,15 @@ TEST(FakeChain, RingsUpToTheSetPointWhileDrivenAndDecaysWhenNot) {
   hrg::fw::ChainCommands cmd;
   cmd.pump_on = true;
   cmd.amplitude_set_v = 0.5;
-  hrg::fw::ChainOutputs out;
+  hrg::fw::ChainRecord out;
   for (int i = 0; i < 100; ++i)
     c.process(adc, dac, cmd, out);
-  DOUBLES_EQUAL(0.5, out.a_a_v, 1e-12);
+  DOUBLES_EQUAL(0.5, out.wave.a_A, 1e-12);
   LONGS_EQUAL(1000, dac[5]);
   cmd.pump_on = false;
   c.decay_per_block = 0.5;
   c.process(adc, dac, cmd, out);
-  DOUBLES_EQUAL(0.25, out.a_a_v, 1e-12);
+  DOUBLES_EQUAL(0.25, out.wave.a_A, 1e-12);
 }
 
 TEST(FakeChain, MovesThePatternTowardsTheTarget) {
@@ -97,7 +97,7 @@ TEST(FakeChain, MovesThePatternTowardsTheTarget) {
   hrg::fw::ChainCommands cmd;
   cmd.pattern_control = true;
   cmd.pattern_target_rad = 0.2;
-  hrg::fw::ChainOutputs out;
+  hrg::fw::ChainRecord out;
   for (int i = 0; i < 50; ++i)
     c.process(adc, dac, cmd, out);
   DOUBLES_EQUAL(0.15, c.theta(), 1e-12);  // from 0.1 at 1e-3 per block
@@ -110,7 +110,7 @@ TEST_GROUP(FakeIdentifier){};
 
 TEST(FakeIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsItsBackDoorValues) {
   hrg::fakes::FakeIdentifier id;
-  hrg::fw::ChainOutputs s;
+  hrg::fw::ChainRecord s;
   id.add_sample(s);  // outside a window: not counted
   id.begin_window(1.5);
   id.add_sample(s);

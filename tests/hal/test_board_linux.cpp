@@ -83,7 +83,7 @@ TEST(LinuxBoard, TheAdcStreamIsReadInItsIioFormat) {
   const uint8_t bytes[16] = {0x80, 0x00, 0xFF, 0xF0, 0x00, 0x00, 0x80, 0x10,
                              0x80, 0x00, 0x80, 0x00, 0x80, 0x00, 0x7F, 0xF0};
   CHECK(::write(fixture.adc_writer, bytes, sizeof bytes) == 16);
-  std::array<sample_q31, 8> block{};
+  std::array<q31_t, 8> block{};
   uint64_t t = 0;
   uint32_t clipped = 0;
   CHECK(Status::ok == board().adc.read_block(block, t, clipped));
@@ -97,7 +97,7 @@ TEST(LinuxBoard, TheAdcStreamIsReadInItsIioFormat) {
 }
 
 TEST(LinuxBoard, TheDacStreamIsWrittenInItsIioFormat) {
-  std::array<sample_q31, 12> block{};
+  std::array<q31_t, 12> block{};
   block[0] = 0x12345678;
   block[11] = INT32_MIN;
   CHECK(Status::ok == board().dac.write_block(block));

@@ -74,7 +74,7 @@ TEST(SampleCodec, EveryCodeOfEveryFormatRoundTrips) {
       // Spread the probes over the whole code range, rails included.
       const uint64_t span = (f.bits == 32 ? 0x100000000ull : (1ull << f.bits)) - 1;
       const uint32_t code = static_cast<uint32_t>(span * k / (n - 1));
-      const auto word = static_cast<sample_q31>(f.bits == 32 ? code : code << (32 - f.bits));
+      const auto word = static_cast<q31_t>(f.bits == 32 ? code : code << (32 - f.bits));
       uint8_t bytes[4] = {};
       encode_sample(word, f, bytes);
       bool clipped = false;
@@ -100,7 +100,7 @@ TEST(StreamConverters, AnAdcBlockIsReadInterleavedWithClippedCount) {
   // 4 frames x 2 channels of s16: x = 0, 1000, 32767 (clipped), -32768 (clipped).
   const int16_t codes[8] = {0, -1, 1000, -1000, 32767, 5, -32768, 6};
   CHECK(::write(fds[1], codes, sizeof codes) == static_cast<ssize_t>(sizeof codes));
-  std::array<sample_q31, 8> block{};
+  std::array<q31_t, 8> block{};
   uint64_t t_first = 0;
   uint32_t clipped = 0;
   const uint64_t before = clock.now_ns();
@@ -118,7 +118,7 @@ TEST(StreamConverters, AnIncompleteBlockTimesOutAndCompletesLater) {
   CHECK(Status::ok == adc.adopt(fds[0], config({16, 2, 0, true, false}), clock));
   const int16_t first[3] = {1, 2, 3};
   CHECK(::write(fds[1], first, sizeof first) > 0);
-  std::array<sample_q31, 8> block{};
+  std::array<q31_t, 8> block{};
   uint64_t t = 0;
   uint32_t clipped = 0;
   CHECK(Status::timeout == adc.read_block(block, t, clipped));
@@ -127,7 +127,7 @@ TEST(StreamConverters, AnIncompleteBlockTimesOutAndCompletesLater) {
   CHECK(Status::ok == adc.read_block(block, t, clipped));
   LONGS_EQUAL(1 * 65536, block[0]);
   LONGS_EQUAL(8 * 65536, block[7]);
-  std::array<sample_q31, 6> wrong{};
+  std::array<q31_t, 6> wrong{};
   CHECK(Status::invalid_argument == adc.read_block(wrong, t, clipped));
 }
 
@@ -136,7 +136,7 @@ TEST(StreamConverters, TheAdcReportsAClosedStream) {
   CHECK(Status::ok == adc.adopt(fds[0], config({16, 2, 0, true, false}), clock));
   ::close(fds[1]);
   fds[1] = -1;
-  std::array<sample_q31, 8> block{};
+  std::array<q31_t, 8> block{};
   uint64_t t = 0;
   uint32_t clipped = 0;
   CHECK(Status::closed == adc.read_block(block, t, clipped));
@@ -148,7 +148,7 @@ TEST(StreamConverters, DacBlocksComeOutTruncatedToTheConverterBits) {
   CHECK(Status::ok == dac.adopt(fds[1], config({12, 2, 4, false, true}, 2)));
   fds[1] = -1;  // owned by the DAC now
   // pump, fx, fy for 2 frames.
-  const std::array<sample_q31, 6> words = {0, INT32_MAX, INT32_MIN, 0x00100000 - 1, -1, 0x40000000};
+  const std::array<q31_t, 6> words = {0, INT32_MAX, INT32_MIN, 0x00100000 - 1, -1, 0x40000000};
   CHECK(Status::ok == dac.write_block(words));
   uint8_t out[12];
   CHECK(::read(rd, out, sizeof out) == 12);
@@ -163,7 +163,7 @@ TEST(StreamConverters, AFullDriverBufferRefusesTheBlockWithoutBlocking) {
   const int rd = fds[0];
   CHECK(Status::ok == dac.adopt(fds[1], config({16, 2, 0, true, false}, 1000)));
   fds[1] = -1;
-  std::vector<sample_q31> block(3000, 0x12345678);
+  std::vector<q31_t> block(3000, 0x12345678);
   // A pipe holds 64 KiB: 6000-byte blocks fill it after 10.
   int ok = 0;
   int refused = 0;

@@ -86,8 +86,8 @@ int main() {
     target().configure(cfg);
     hrg::hal::Board& b = hrg::hal::board();
     b.excitation_enable.write(true);
-    std::vector<hrg::hal::sample_q31> adc(200);
-    std::vector<hrg::hal::sample_q31> dac(300, 1 << 28);
+    std::vector<hrg::hal::q31_t> adc(200);
+    std::vector<hrg::hal::q31_t> dac(300, 1 << 28);
     uint64_t t_ns = 0;
     uint32_t clipped = 0;
     const Clock t0;

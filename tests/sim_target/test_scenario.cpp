@@ -85,8 +85,8 @@ TEST(Scenario, OutOfRangeValuesNameTheKeyAndTheAllowedRange) {
 
 TEST(Scenario, SameSeedGivesTheSameBits) {
   SimConfig c = load_scenario(source_dir() + "/sim_target/scenarios/default.toml");
-  std::vector<hal::sample_q31> a(200);
-  std::vector<hal::sample_q31> b(200);
+  std::vector<hal::q31_t> a(200);
+  std::vector<hal::q31_t> b(200);
   uint64_t t_ns = 0;
   uint32_t clipped = 0;
   target().configure(c);

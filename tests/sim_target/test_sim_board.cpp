@@ -14,14 +14,14 @@ using namespace hrg::sim;
 
 namespace {
 
-std::vector<hal::sample_q31> read_one(hal::Board& b, uint64_t& t_ns, uint32_t& clipped) {
-  std::vector<hal::sample_q31> v(b.adc.info().block_frames * hal::kAdcChannels);
+std::vector<hal::q31_t> read_one(hal::Board& b, uint64_t& t_ns, uint32_t& clipped) {
+  std::vector<hal::q31_t> v(b.adc.info().block_frames * hal::kAdcChannels);
   CHECK(b.adc.read_block(v, t_ns, clipped) == hal::Status::ok);
   return v;
 }
 
 void write_constant(hal::Board& b, const DacQuantizer& q, double pump_v, double fx_v) {
-  std::vector<hal::sample_q31> v(b.dac.info().block_frames * hal::kDacChannels);
+  std::vector<hal::q31_t> v(b.dac.info().block_frames * hal::kDacChannels);
   for (std::size_t k = 0; k < v.size(); k += 3) {
     v[k] = q.word_for(pump_v);
     v[k + 1] = q.word_for(fx_v);
@@ -132,7 +132,7 @@ TEST(SimBoard, ForcerRingsTheResonatorUpAtTheForcerGain) {
   const double h = 1e-5;
   uint64_t t_ns = 0;
   uint32_t clipped = 0;
-  std::vector<hal::sample_q31> block(300);
+  std::vector<hal::q31_t> block(300);
   read_one(b, t_ns, clipped);
   // WHEN 1 V forcer is applied for 1 s (100 blocks written one ahead)
   for (int k = 0; k < 1000; ++k) {
@@ -284,7 +284,7 @@ TEST(SimBoard, AdcOffsetShiftsTheMeanAndDacRailCodesAreCounted) {
   const auto v = read_one(b, t_ns, clipped);
   DOUBLES_EQUAL(0.25, aq.to_volts(v[0]), aq.lsb_v());
   DOUBLES_EQUAL(-0.5, aq.to_volts(v[1]), aq.lsb_v());
-  std::vector<hal::sample_q31> rail(300, INT32_MAX);
+  std::vector<hal::q31_t> rail(300, INT32_MAX);
   b.dac.write_block(rail);
   read_one(b, t_ns, clipped);
   CHECK_EQUAL(300u, target().counters().dac_saturated);

@@ -92,16 +92,35 @@ struct ChainConfig {
 // first bad field.
 const char* check_chain_config(const ChainConfig& c);
 
-// Slow outputs, one set per block (control rate).
+// Control-loop drift inputs (seed sections 6-7).
+// The pump acting during a block was phased from the previous block's wave
+// phase; against the wave phase phi_A measured now its error is
+// eps = pi/2 - 2 (phi_V - phi_A), wrapped to (-pi, pi]: 0 when the pump
+// leads the wave by the ideal quarter turn of 2 phi.
+double pump_phase_error_rad(double prev_pump_phase_rad, double wave_phase_rad);
+// The quadrature drive u_q (forcer volts along the node, in phase with wave
+// A's displacement) changes a_B at g u_q / (2 w), V/s; it has no commanded
+// part on the angle.
+double quad_force_rate_v_s(double forcer_gain_per_s2, double w_rad_s, double u_q_v);
+
+// Slow outputs, one set per block (control rate), SI units.
 struct ChainOutputs {
-  Quadratures<double> quad;       // cx, sx, cy, sy, volts of pickoff
-  WaveVariables<double> wave;     // E, Q, R, S (V^2), a_A, a_B (V), theta wrapped, phase
-  double theta_A_rad = 0.0;       // unwrapped pattern angle
-  double phase_err_rad = 0.0;     // PLL phase detector output (wave phase mod pi)
-  double pll_freq_hz = 0.0;       // NCO frequency for the next block
-  double pump_v = 0.0;            // pump amplitude V0
-  double pump_phase_rad = 0.0;    // phi_V against the NCO
-  double quad_effort_v = 0.0;     // u_q, forcer volts along the node
+  Quadratures<double> quad;     // cx, sx, cy, sy, volts of pickoff
+  WaveVariables<double> wave;   // E, Q, R, S (V^2), a_A, a_B (V), theta wrapped, phase
+  double theta_A_rad = 0.0;     // unwrapped pattern angle
+  double phase_err_rad = 0.0;   // PLL phase detector output (wave phase mod pi)
+  double pll_freq_hz = 0.0;     // NCO frequency for the next block
+  double pump_v = 0.0;          // pump amplitude V0
+  double pump_phase_rad = 0.0;  // phi_V against the NCO
+  double quad_effort_v = 0.0;   // u_q, forcer volts along the node
+  double quad_effort = 0.0;     // u_q / forcer_max_v, -1..1
+  // Control-loop drift inputs: the pump's phase error (0 on the first block
+  // and while the pump is off) and the quadrature forcers' commanded action,
+  // the part on a_B' (sin) and the part on the angle (cos), V/s. The pattern
+  // drive is left out: it turns the pattern on purpose (output held).
+  double pump_phase_error_rad = 0.0;
+  double quad_force_sin_v_s = 0.0;
+  double quad_force_cos_v_s = 0.0;
   double pattern_effort_v = 0.0;  // u_r
   double ring_up_drive_v = 0.0;   // u_a
   bool locked = false;
@@ -159,6 +178,7 @@ class Chain {
 
  private:
   void update_loops(const WaveVariables<double>& w, double dt_s);
+  void update_drift_inputs(bool had_pump_phase, double prev_pump_phase_rad);
   void synthesize(uint32_t phase_block_start, std::span<q31_t> dac) const;
 
   ChainConfig cfg_;
@@ -175,6 +195,7 @@ class Chain {
   bool pump_on_ = false;
   bool forcers_on_ = false;
   bool ring_up_ = true;
+  bool have_pump_phase_ = false;  // out_.pump_phase_rad holds a previous block's
   bool pattern_enabled_ = false;
   double pattern_target_rad_ = 0.0;
   double pattern_max_rate_rad_s_ = 0.0;

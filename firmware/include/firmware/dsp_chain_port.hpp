@@ -3,12 +3,16 @@
 
 #include <cstdint>
 #include <span>
+#include <type_traits>
 
 #include "dsp/chain.hpp"
 #include "dsp/fixed.hpp"
 #include "firmware/ports.hpp"
 
 namespace hrg::fw {
+
+static_assert(std::is_same_v<hal::q31_t, dsp::q31_t>,
+              "the HAL's sample words are the chain's Q1.31 words");
 
 // The converter layout as the chain must know it (from the board's HAL
 // converter info and data sheet, or the simulated target's configuration).
@@ -36,7 +40,7 @@ double max_pattern_rate_rad_s(const dsp::ChainConfig& cfg, double margin = 0.8);
 
 // The firmware's SignalChain over dsp::Chain: the mode policy gates the pump
 // and the forcers separately, the pattern command steers theta_A (at no more
-// than the forcers can do), and the chain's slow outputs become ChainOutputs.
+// than the forcers can do), and the chain's outputs are stamped into the record.
 // The fast path is Q1.31 (bit-exact with the Cortex-M7 build).
 class DspChainPort final : public SignalChain {
  public:
@@ -47,8 +51,8 @@ class DspChainPort final : public SignalChain {
   // `pattern_max_rate_rad_s` takes the forcers' limit; a larger one is clamped to it.
   explicit DspChainPort(const dsp::ChainConfig& cfg, double pattern_max_rate_rad_s = 0.0);
 
-  void process(std::span<const hal::sample_q31> adc, std::span<hal::sample_q31> dac,
-               const ChainCommands& cmd, ChainOutputs& out) override;
+  void process(std::span<const hal::q31_t> adc, std::span<hal::q31_t> dac, const ChainCommands& cmd,
+               ChainRecord& out) override;
 
   bool usable() const { return error_ == nullptr; }
   // nullptr when usable, else the configuration error.
@@ -61,8 +65,6 @@ class DspChainPort final : public SignalChain {
   const char* error_;
   dsp::Chain<Sample> chain_;
   double pattern_max_rate_rad_s_;
-  double last_pump_phase_rad_ = 0.0;
-  bool have_pump_phase_ = false;
 };
 
 }  // namespace hrg::fw

@@ -14,7 +14,7 @@ class EstimatorPort final : public Identifier {
   explicit EstimatorPort(const est::Estimator::Config& cfg) : est_(cfg) {}
 
   void begin_window(double t_s) override;
-  void add_sample(const ChainOutputs& s) override;
+  void add_sample(const ChainRecord& s) override;
   void end_window() override;
   void abort_window() override;
   void solve() override;
@@ -23,7 +23,7 @@ class EstimatorPort final : public Identifier {
   double drift_rad_s(double theta_a_rad, double ab_over_aa) const override {
     return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa);
   }
-  void add_control_sample(const ChainOutputs& s) override;
+  void add_control_sample(const ChainRecord& s) override;
   double control_drift_rad_s(double theta_a_rad) const override;
   // The pump's gap part of D_Phi is used only when the fitted gap harmonic
   // |eps| = 2 |(b1, b2)| / b0 is at least this: on an ideal electrode the

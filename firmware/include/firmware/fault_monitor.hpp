@@ -54,6 +54,6 @@ class FaultMonitor {
 
 // True when some ADC channel holds one value over the whole interleaved block
 // (a stuck converter or a broken pickoff wire). Allocation-free, one pass.
-bool adc_block_stuck(std::span<const hal::sample_q31> frames, std::size_t channels);
+bool adc_block_stuck(std::span<const hal::q31_t> frames, std::size_t channels);
 
 }  // namespace hrg::fw

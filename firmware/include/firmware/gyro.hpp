@@ -35,7 +35,7 @@ struct GyroConfig {
 
 // Everything the firmware reports once per frame (telemetry, recordings).
 struct GyroStatus {
-  ChainOutputs chain{};
+  ChainRecord chain{};
   Mode mode = Mode::power_up;
   uint16_t faults = 0;
   bool excitation_on = false;  // drives permitted by the mode (exc column)
@@ -143,8 +143,8 @@ class Gyro {
   uint32_t cmd_accepted_ = 0;
   uint32_t cmd_refused_ = 0;
   ChainCommands commands_{};
-  std::array<hal::sample_q31, kBlockFrames * hal::kAdcChannels> adc_{};
-  std::array<hal::sample_q31, kBlockFrames * hal::kDacChannels> dac_{};
+  std::array<hal::q31_t, kBlockFrames * hal::kAdcChannels> adc_{};
+  std::array<hal::q31_t, kBlockFrames * hal::kDacChannels> dac_{};
   uint64_t expected_block_ns_ = 0;
   uint64_t block_ns_ = 0;
   uint32_t adc_clipped_ = 0;

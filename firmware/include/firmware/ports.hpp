@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <span>
 
+#include "dsp/chain.hpp"
 #include "firmware/shutdown_scheduler.hpp"
 #include "hal/converters.hpp"
 
@@ -19,24 +20,13 @@ struct ChainCommands {
   double amplitude_set_v = 1.0;  // AGC set point for a_A
 };
 
-// Slow (one per block) outputs of the signal chain, SI units.
-struct ChainOutputs {
-  double t_s = 0.0;                                       // time of the block end
-  double cx_v = 0.0, sx_v = 0.0, cy_v = 0.0, sy_v = 0.0;  // demodulated quadratures
-  double e_v2 = 0.0;                                      // E = a_A^2 + a_B^2
-  double a_a_v = 0.0;                                     // working wave amplitude
-  double a_b_v = 0.0;                                     // quadrature wave amplitude (signed)
-  double theta_a_rad = 0.0;                               // pattern angle, (-pi/4, pi/4]
-  double f_ref_hz = 0.0;                                  // NCO (reference) frequency
-  double pump_v = 0.0;                                    // pump amplitude being output
-  double quad_effort = 0.0;                               // quadrature forcer command, -1..1
-  // Control-loop drift inputs (seed sections 6-7): the pump phase error
-  // eps = pi/2 - 2 (phi_V - phi_A) and the quadrature forcers' commanded
-  // action, the part on a_B' (sin) and the part on the angle (cos), V/s.
-  double pump_phase_error_rad = 0.0;
-  double quad_sin_v_s = 0.0;
-  double quad_cos_v_s = 0.0;
-  bool locked = false;  // PLL lock detector
+// One block of the signal chain as the firmware records it: the chain's
+// outputs (quadratures, wave variables, unwrapped angle, PLL, drives and the
+// control-loop drift inputs, SI units; dsp/chain.hpp) stamped with the time of
+// the block's end on the board's clock. The estimator's samples, the output
+// and the telemetry are all read from this one record.
+struct ChainRecord : dsp::ChainOutputs {
+  double t_s = 0.0;  // time of the block end
 };
 
 // The DSP chain as the firmware sees it: once per ADC block, ADC block in, DAC
@@ -46,8 +36,8 @@ class SignalChain {
   virtual ~SignalChain() = default;
   // `adc`: interleaved [x, y] frames; `dac`: interleaved [pump, fx, fy] frames
   // to fill. Task context, once per base frame; must not allocate.
-  virtual void process(std::span<const hal::sample_q31> adc, std::span<hal::sample_q31> dac,
-                       const ChainCommands& cmd, ChainOutputs& out) = 0;
+  virtual void process(std::span<const hal::q31_t> adc, std::span<hal::q31_t> dac,
+                       const ChainCommands& cmd, ChainRecord& out) = 0;
   // nullptr when the chain's configuration is usable, else what is wrong
   // (the firmware then keeps the drives off).
   virtual const char* config_error() const { return nullptr; }
@@ -66,7 +56,7 @@ class Identifier {
   virtual ~Identifier() = default;
   // Free-decay window bracket; samples in between feed the least squares.
   virtual void begin_window(double t_s) = 0;
-  virtual void add_sample(const ChainOutputs& s) = 0;
+  virtual void add_sample(const ChainRecord& s) = 0;
   virtual void end_window() = 0;
   virtual void abort_window() = 0;
   // Slow task: refresh the solution from the accumulated normal equations.
@@ -78,7 +68,7 @@ class Identifier {
   virtual double drift_rad_s(double theta_a_rad, double ab_over_aa) const = 0;
   // Control-loop drift D_Phi (seed sections 6-7, eq. 23): fed with the
   // excitation on, added to the output only with the excitation on.
-  virtual void add_control_sample(const ChainOutputs& s) { (void)s; }
+  virtual void add_control_sample(const ChainRecord& s) { (void)s; }
   virtual double control_drift_rad_s(double theta_a_rad) const {
     (void)theta_a_rad;
     return 0.0;

@@ -12,7 +12,8 @@ namespace hrg::hal {
 // Sample words are Q1.31 fractions of the converter's full scale: INT32_MIN is
 // -full scale, INT32_MAX is +full scale (less one LSB). A converter with fewer
 // bits left-justifies its code, so the firmware never depends on resolution.
-using sample_q31 = int32_t;
+// The same word as dsp::q31_t (the firmware checks that they agree).
+using q31_t = int32_t;
 
 inline constexpr std::size_t kAdcChannels = 2;  // 0: pickoff x (C), 1: pickoff y (D)
 inline constexpr std::size_t kDacChannels =
@@ -33,8 +34,7 @@ class Adc : NonCopyable {
   // block_frames * kAdcChannels words. `t_first_ns` is the sample time of the
   // first frame on the HAL's monotonic clock. `clipped` counts samples at a rail.
   // Called from the executive's base frame only.
-  virtual Status read_block(std::span<sample_q31> frames, uint64_t& t_first_ns,
-                            uint32_t& clipped) = 0;
+  virtual Status read_block(std::span<q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped) = 0;
 };
 
 // Drive DAC. Blocks are interleaved frames: [pump0, fx0, fy0, pump1, ...].
@@ -44,7 +44,7 @@ class Dac : NonCopyable {
   virtual ConverterInfo info() const = 0;
   // Queues one block to be output one block later (the converter double-buffers).
   // `frames` must hold block_frames * kDacChannels words.
-  virtual Status write_block(std::span<const sample_q31> frames) = 0;
+  virtual Status write_block(std::span<const q31_t> frames) = 0;
 };
 
 }  // namespace hrg::hal

@@ -78,7 +78,7 @@ bool valid(const SampleFormat& f) {
   return storage_ok && f.bits >= 2 && f.bits <= 32 && f.shift + f.bits <= 8 * f.storage_bytes;
 }
 
-sample_q31 decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped) {
+q31_t decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped) {
   const uint32_t mask = f.bits == 32 ? 0xFFFFFFFFu : (1u << f.bits) - 1u;
   uint32_t code = (load(p, f) >> f.shift) & mask;
   // Offset binary: flipping the top bit turns it into two's complement.
@@ -86,10 +86,10 @@ sample_q31 decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped)
   const uint32_t top = 1u << (f.bits - 1);
   clipped = code == top || code == top - 1u;  // most negative / most positive code
   // Left-justify: Q1.31 full scale whatever the resolution.
-  return static_cast<sample_q31>(code << (32 - f.bits));
+  return static_cast<q31_t>(code << (32 - f.bits));
 }
 
-void encode_sample(sample_q31 word, const SampleFormat& f, uint8_t* p) {
+void encode_sample(q31_t word, const SampleFormat& f, uint8_t* p) {
   const uint32_t mask = f.bits == 32 ? 0xFFFFFFFFu : (1u << f.bits) - 1u;
   uint32_t code = (static_cast<uint32_t>(word) >> (32 - f.bits)) & mask;  // truncates
   if (!f.is_signed) code ^= 1u << (f.bits - 1);
@@ -124,7 +124,7 @@ Status StreamAdc::adopt(int fd, const StreamConfig& config, MonotonicClock& cloc
   return Status::ok;
 }
 
-Status StreamAdc::read_block(std::span<sample_q31> frames, uint64_t& t_first_ns,
+Status StreamAdc::read_block(std::span<q31_t> frames, uint64_t& t_first_ns,
                              uint32_t& clipped) {
   if (fd_ < 0) return Status::closed;
   if (frames.size() != static_cast<std::size_t>(config_.info.block_frames) * kAdcChannels) {
@@ -202,7 +202,7 @@ Status StreamDac::flush_pending() {
   return Status::ok;
 }
 
-Status StreamDac::write_block(std::span<const sample_q31> frames) {
+Status StreamDac::write_block(std::span<const q31_t> frames) {
   if (fd_ < 0) return Status::closed;
   if (frames.size() != static_cast<std::size_t>(config_.info.block_frames) * kDacChannels) {
     return Status::invalid_argument;

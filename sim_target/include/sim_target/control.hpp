@@ -83,14 +83,14 @@ class SimTarget {
     SimTarget* t;
     explicit SimAdc(SimTarget* owner) : t(owner) {}
     hal::ConverterInfo info() const override;
-    hal::Status read_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+    hal::Status read_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                            uint32_t& clipped) override;
   };
   struct SimDac final : hal::Dac {
     SimTarget* t;
     explicit SimDac(SimTarget* owner) : t(owner) {}
     hal::ConverterInfo info() const override;
-    hal::Status write_block(std::span<const hal::sample_q31> frames) override;
+    hal::Status write_block(std::span<const hal::q31_t> frames) override;
   };
   struct SimExcitation final : hal::DigitalOut {
     bool value = false;
@@ -112,9 +112,9 @@ class SimTarget {
     uint64_t now_ns() const override;
     hal::Status sleep_until_ns(uint64_t t_ns) override;
   };
-  using DacFrame = std::array<hal::sample_q31, hal::kDacChannels>;
+  using DacFrame = std::array<hal::q31_t, hal::kDacChannels>;
 
-  hal::Status produce_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+  hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                             uint32_t& clipped);
   Drive next_drive();
   uint64_t sample_time_ns(uint64_t index) const;
@@ -142,7 +142,7 @@ class SimTarget {
   bool dac_written_ = false;
   std::array<bool, 2> adc_stuck_{};
   std::array<bool, 2> adc_saturated_{};
-  std::array<hal::sample_q31, 2> adc_last_{};
+  std::array<hal::q31_t, 2> adc_last_{};
   std::array<bool, hal::kDacChannels> dac_dead_{};
   double burst_rms_v_ = 0.0;
   double burst_left_s_ = 0.0;

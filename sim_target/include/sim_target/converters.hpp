@@ -21,10 +21,10 @@ namespace hrg::sim {
 class AdcQuantizer {
  public:
   explicit AdcQuantizer(const AdcConfig& c = {});
-  hal::sample_q31 convert(double v, bool& clipped) const;
+  hal::q31_t convert(double v, bool& clipped) const;
   double lsb_v() const { return lsb_v_; }
   // Volts of a Q1.31 word (for tests and the back door).
-  double to_volts(hal::sample_q31 word) const;
+  double to_volts(hal::q31_t word) const;
 
  private:
   uint32_t bits_;
@@ -36,9 +36,9 @@ class AdcQuantizer {
 class DacQuantizer {
  public:
   explicit DacQuantizer(const DacConfig& c = {});
-  double convert(hal::sample_q31 word, bool& saturated) const;
+  double convert(hal::q31_t word, bool& saturated) const;
   // The Q1.31 word whose output is closest to v (tests, envelope helpers).
-  hal::sample_q31 word_for(double v) const;
+  hal::q31_t word_for(double v) const;
 
  private:
   uint32_t bits_;

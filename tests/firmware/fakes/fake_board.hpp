@@ -18,7 +18,7 @@ class FakeAdc final : public hal::Adc {
  public:
   explicit FakeAdc(FakeClock& clock) : clock_(clock) {}
   hal::ConverterInfo info() const override { return {rate_hz_, block_frames_, 2.5}; }
-  hal::Status read_block(std::span<hal::sample_q31> frames, uint64_t& t_first_ns,
+  hal::Status read_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                          uint32_t& clipped) override {
     ++reads_;
     if (status_ != hal::Status::ok) return status_;
@@ -26,7 +26,7 @@ class FakeAdc final : public hal::Adc {
     clock_.set_now_ns(t_first_ns + block_ns());
     skip_blocks_ = 0;
     for (std::size_t i = 0; i < frames.size(); ++i) {
-      frames[i] = static_cast<hal::sample_q31>((counter_++ % 1000) * 1000);
+      frames[i] = static_cast<hal::q31_t>((counter_++ % 1000) * 1000);
       if (stuck_ && i % hal::kAdcChannels == 1) frames[i] = 12345;
     }
     clipped = clipped_;
@@ -60,7 +60,7 @@ class FakeAdc final : public hal::Adc {
 class FakeDac final : public hal::Dac {
  public:
   hal::ConverterInfo info() const override { return {fw::kAdcRateHz, fw::kBlockFrames, 10.0}; }
-  hal::Status write_block(std::span<const hal::sample_q31> frames) override {
+  hal::Status write_block(std::span<const hal::q31_t> frames) override {
     ++writes_;
     for (std::size_t i = 0; i < frames.size() && i < last_.size(); ++i)
       last_[i] = frames[i];
@@ -77,7 +77,7 @@ class FakeDac final : public hal::Dac {
   uint32_t writes() const { return writes_; }
 
  private:
-  std::array<hal::sample_q31, fw::kBlockFrames * hal::kDacChannels> last_{};
+  std::array<hal::q31_t, fw::kBlockFrames * hal::kDacChannels> last_{};
   hal::Status status_ = hal::Status::ok;
   uint32_t writes_ = 0;
 };

@@ -17,8 +17,8 @@ namespace hrg::fakes {
 // It writes a constant into every DAC word so the mode gate can be seen.
 class FakeChain final : public fw::SignalChain {
  public:
-  void process(std::span<const hal::sample_q31>, std::span<hal::sample_q31> dac,
-               const fw::ChainCommands& cmd, fw::ChainOutputs& out) override {
+  void process(std::span<const hal::q31_t>, std::span<hal::q31_t> dac, const fw::ChainCommands& cmd,
+               fw::ChainRecord& out) override {
     ++calls_;
     last_cmd_ = cmd;
     for (auto& w : dac)
@@ -37,10 +37,10 @@ class FakeChain final : public fw::SignalChain {
                     ? err
                     : std::copysign(pattern_rate_rad_per_block, err);
     }
-    out.a_a_v = a_a_;
-    out.a_b_v = 0.0;
-    out.e_v2 = a_a_ * a_a_;
-    out.theta_a_rad = std::remainder(theta_, 1.5707963267948966);
+    out.wave.a_A = a_a_;
+    out.wave.a_B = 0.0;
+    out.wave.E = a_a_ * a_a_;
+    out.theta_A_rad = std::remainder(theta_, 1.5707963267948966);
     out.locked = locked;
     out.pump_v = cmd.pump_on ? 3.0 : 0.0;
   }
@@ -72,7 +72,7 @@ class FakeIdentifier final : public fw::Identifier {
     last_begin_s = t_s;
     open = true;
   }
-  void add_sample(const fw::ChainOutputs&) override { samples += open ? 1 : 0; }
+  void add_sample(const fw::ChainRecord&) override { samples += open ? 1 : 0; }
   void end_window() override {
     ++ended;
     open = false;

@@ -47,7 +47,7 @@ class StreamAdc final : public Adc {
   // Waits up to two block periods for the rest of the block; timeout when it
   // is still incomplete (the part read is kept for the next call). The first
   // frame's time is the completion time less one block duration.
-  Status read_block(std::span<sample_q31> frames, uint64_t& t_first_ns, uint32_t& clipped) override;
+  Status read_block(std::span<q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped) override;
 
  private:
   int fd_ = -1;
@@ -73,7 +73,7 @@ class StreamDac final : public Dac {
   // Queues one block. would_block when the driver's buffer cannot take it
   // (nothing of this block is written then, unless a previous block's tail is
   // still pending, which goes first).
-  Status write_block(std::span<const sample_q31> frames) override;
+  Status write_block(std::span<const q31_t> frames) override;
   uint32_t refused_blocks() const { return refused_; }
 
  private:
@@ -87,8 +87,8 @@ class StreamDac final : public Dac {
 };
 
 // Codec of one sample (exposed for tests): storage bytes <-> Q1.31.
-sample_q31 decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped);
-void encode_sample(sample_q31 word, const SampleFormat& f, uint8_t* p);
+q31_t decode_sample(const uint8_t* p, const SampleFormat& f, bool& clipped);
+void encode_sample(q31_t word, const SampleFormat& f, uint8_t* p);
 bool valid(const SampleFormat& f);
 // Parses an IIO scan element type ("le:s16/16>>0", "be:u12/16>>4"; a repeat
 // count "X2" is not supported). Returns false for anything else.
