@@ -21,7 +21,11 @@ double DriftCompensator::step(double theta_A_rad, double aB_over_aA, double d_ph
                               double dt_s) {
   const double d =
       (have_model_ ? resonator_drift_rad_s(p_, theta_A_rad, aB_over_aA) : 0.0) + d_phi_rad_s;
-  const double rate = d / k_;
+  return integrate(d, dt_s);
+}
+
+double DriftCompensator::integrate(double d_rad_s, double dt_s) {
+  const double rate = d_rad_s / k_;
   // Trapezoid on the rate: a model update changes the slope, never the value.
   correction_rad_ += 0.5 * dt_s * ((have_rate_ ? rate_rad_s_ : rate) + rate);
   rate_rad_s_ = rate;
@@ -184,6 +188,16 @@ Eigen::Vector3d PumpDriftEstimator::coefficients() const {
 double PumpDriftEstimator::d_phi_rad_s(double theta_A_rad) const {
   const Eigen::Vector3d c = coefficients();
   return w_last_ * (c(2) * std::cos(4.0 * theta_A_rad) - c(1) * std::sin(4.0 * theta_A_rad));
+}
+
+}  // namespace hrg::est
+
+namespace hrg::est {
+
+double PumpDriftEstimator::gap() const {
+  if (!valid()) return 0.0;
+  const Eigen::Vector3d c = coefficients();
+  return c(0) > 0.0 ? 2.0 * std::hypot(c(1), c(2)) / c(0) : 0.0;
 }
 
 }  // namespace hrg::est

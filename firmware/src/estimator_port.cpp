@@ -56,19 +56,8 @@ void EstimatorPort::add_control_sample(const ChainRecord& s) {
   (void)est_.add_control_sample(c);
 }
 
-double EstimatorPort::pump_gap() const {
-  const est::PumpDriftEstimator& pd = est_.pump_drift();
-  if (!pd.valid()) return 0.0;
-  const Eigen::Vector3d c = pd.coefficients();
-  return c(0) > 0.0 ? 2.0 * std::hypot(c(1), c(2)) / c(0) : 0.0;
-}
-
 double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {
-  if (!est_.has_model()) return 0.0;
-  const est::PumpDriftEstimator& pd = est_.pump_drift();
-  const double pump = pd.valid() ? pd.d_phi_rad_s(theta_a_rad) : 0.0;
-  const double loops = est_.d_phi_rad_s(theta_a_rad) - pump;  // eq. 23 part
-  return loops + (pump_gap() >= min_pump_gap_ ? pump : 0.0);
+  return est_.has_model() ? est_.d_phi_rad_s(theta_a_rad) : 0.0;
 }
 
 void EstimatorPort::solve() {

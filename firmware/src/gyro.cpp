@@ -16,7 +16,8 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
       exec_(kGyroTasks, kBaseRateHz, board.clock, timer, pacing),
       monitor_(cfg.monitor),
       scheduler_(cfg.windows),
-      output_(cfg.angular_gain, 1.0 / kBaseRateHz) {
+      output_(cfg.angular_gain, 1.0 / kBaseRateHz),
+      link_(board.can, kCanRestartRuns) {
   monitor_.set_amplitude_set_v(cfg_.amplitude_set_v);
   const hal::ConverterInfo adc = board.adc.info();
   const hal::ConverterInfo dac = board.dac.info();
@@ -28,6 +29,8 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
               adc.sample_rate_hz == kAdcRateHz && chain.config_error() == nullptr;
   block_ns_ = 1'000'000'000ull / kBaseRateHz;
   (void)board_.excitation_enable.write(false);
+  // Receive only the command range (where the controller can filter).
+  (void)link_.init();
 }
 
 void Gyro::command_pattern_angle(double theta_rad) {
@@ -298,51 +301,34 @@ void Gyro::task_telemetry(Gyro& g) {
 
   std::array<hal::CanFrame, can::kTelemetryCount> frames{};
   const std::size_t n = g.telemetry_.tick(s, frames);
-  for (std::size_t i = 0; i < n; ++i) {
-    // A full queue drops the frame (counted by the driver and here); the
-    // executive never waits for the bus.
-    if (g.board_.can.send(frames[i]) != hal::Status::ok) ++g.can_refused_;
-  }
+  // A full queue drops the frame (counted by the driver and the link); the
+  // executive never waits for the bus.
+  g.link_.send(std::span<const hal::CanFrame>(frames.data(), n));
 }
 
 void Gyro::task_commands(Gyro& g) {
+  // Bus-off recovery is the link's (one policy): the controller stays off the
+  // bus for kCanRestartRuns runs, then is restarted; nothing else would bring
+  // it back. Nothing is received while it is off.
+  const bool bus_off = g.board_.can.state() == hal::CanState::bus_off;
+  g.link_.service();
+  if (bus_off) return;
   can::ControllerView view;
-  view.mode = g.mode_.mode();
   view.faults = static_cast<uint16_t>(g.status_.faults | g.mode_.faults());
   view.fault_input = g.status_.fault_input;
   view.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
-  view.agc_setpoint_v = g.cfg_.amplitude_set_v;
-  // Bus-off recovery (the policy of can::CanLink::service): the controller
-  // stays off the bus for a while, then is restarted; nothing else would
-  // bring it back.
-  if (g.board_.can.state() == hal::CanState::bus_off) {
-    if (++g.can_off_runs_ >= kCanRestartRuns) {
-      g.can_off_runs_ = 0;
-      ++g.can_restarts_;
-      (void)g.board_.can.restart();
-    }
-    return;
-  }
-  g.can_off_runs_ = 0;
   for (uint32_t n = 0; n < kCommandsPerRun; ++n) {
-    hal::CanFrame f;
-    if (g.board_.can.receive(f) != hal::Status::ok) break;
-    const can::CommandOutcome out = g.validator_.process(f, view);
-    if (!out.for_us) continue;
-    if (out.result == can::CommandResult::accepted) {
-      ++g.cmd_accepted_;
-      g.apply(out.command);
-    } else {
-      ++g.cmd_refused_;
-    }
-    if (g.board_.can.send(out.reply) != hal::Status::ok) ++g.can_refused_;
-    if (out.result == can::CommandResult::accepted && out.command.id == can::Cmd::status_request) {
-      hal::CanFrame status;
-      g.telemetry_.encode_now(can::Tm::status, g.snapshot_, status);
-      if (g.board_.can.send(status) != hal::Status::ok) ++g.can_refused_;
-    }
+    // Each command is validated against the state the previous one left.
     view.mode = g.mode_.mode();
     view.agc_setpoint_v = g.cfg_.amplitude_set_v;
+    can::Command cmd;
+    if (!g.link_.poll(view, cmd)) break;  // refused ones are answered by the link
+    g.apply(cmd);
+    if (cmd.id == can::Cmd::status_request) {
+      hal::CanFrame status;
+      g.telemetry_.encode_now(can::Tm::status, g.snapshot_, status);
+      g.link_.send({&status, 1});
+    }
   }
 }
 

@@ -3,9 +3,9 @@
 // simulated converters of sim_target behind the ADC/DAC seam (no hardware
 // needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
-// The firmware sends its telemetry on IF at the default rates and answers the
-// commands of the DBC with its own command task; the board adds the receive
-// filter and restarts the controller after 100 ms of bus-off. Runs until
+// The firmware sends its telemetry on IF at the default rates, answers the
+// commands of the DBC and restarts the controller after 100 ms of bus-off, all
+// through its own CAN link (receive filter set at start). Runs until
 // SIGTERM/SIGINT or S seconds.
 #include <signal.h>
 
@@ -18,7 +18,6 @@
 #include <string>
 
 #include "firmware/app/firmware.hpp"
-#include "firmware/can/link.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
@@ -120,11 +119,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   fw::Gyro* gyro = &firmware->gyro();
-  // The firmware's command task receives and answers commands itself; the
-  // board adds the command filter and the bus-off restart policy.
-  fw::can::CanLink link(can, fw::kBaseRateHz / 10);
-  link.init();
-
   struct sigaction sa {};
   sa.sa_handler = on_stop;
   sigaction(SIGTERM, &sa, nullptr);
@@ -138,7 +132,6 @@ int main(int argc, char** argv) {
     const fw::GyroStatus& st = gyro->status();
     if (st.enable_line != last_exc) ++exc_edges;
     last_exc = st.enable_line;
-    link.service();
   }
   const auto& fs = gyro->executive().frame_stats();
   const auto c = can.counters();

@@ -47,6 +47,12 @@ class DriftCompensator {
   // loop drift estimate d_phi_rad_s (0 during free decay or if not estimated).
   // Trapezoid rule on the rate; returns the correction to add to the raw angle.
   double step(double theta_A_rad, double aB_over_aA, double d_phi_rad_s, double dt_s);
+  // The same rule for a drift D (rad/s, Omega K units) computed elsewhere:
+  // the correction advances by the trapezoid of D/K over dt_s.
+  double integrate(double d_rad_s, double dt_s);
+  // After a gap in the steps (output invalid): the next step starts the
+  // trapezoid afresh instead of averaging across the gap.
+  void restart_rate() { have_rate_ = false; }
   double correction_rad() const { return correction_rad_; }
   // Last modelled input-rate correction D/K, rad/s.
   double rate_rad_s() const { return rate_rad_s_; }
@@ -150,6 +156,12 @@ class PumpDriftEstimator {
     double max_kappa_2 = 1.0e3;      // conditioning of the 3x3 before the gap terms are used
     double min_fit_s = 20.0;         // folded excitation-on time before the fit is used
     double max_sample_gap_s = 0.005;
+    // The pump's part of D_Phi is used (Estimator::d_phi_rad_s) only when
+    // the fitted gap harmonic gap() is at least this. On an ideal electrode
+    // the fit leaves |eps| ~ 3e-4 (the default scenario, 1 h), whose D_Phi
+    // (nu |eps| / 2, 0.1-0.3 deg/h) is noise, not drift; a machined gap
+    // harmonic of 1e-2 drifts by ~10 deg/h. 0: always used.
+    double min_gap = 0.0;
   };
   using Sample = ControlDriftEstimator::Sample;
 
@@ -171,6 +183,10 @@ class PumpDriftEstimator {
   double d_phi_rad_s(double theta_A_rad) const;
   // (b0, b1, b2) = c (1, eps_p/2, eps_q/2); zero before valid().
   Eigen::Vector3d coefficients() const;
+  // The fitted gap harmonic |eps| = 2 |(b1, b2)| / b0; 0 before valid().
+  double gap() const;
+  // valid() and gap() >= Config::min_gap: the pump's D_Phi is worth adding.
+  bool usable() const { return valid() && gap() >= config_.min_gap; }
 
  private:
   using Vec4 = Eigen::Matrix<double, 4, 1>;

@@ -90,7 +90,7 @@ class Estimator {
   // D_Phi at pattern angle theta (eq. 23 part + ring-pump gap part), rad/s.
   double d_phi_rad_s(double theta_A_rad) const {
     return (control_.valid() ? control_.d_phi_rad_s() : 0.0) +
-           (pump_.valid() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
+           (pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
   }
   const PumpDriftEstimator& pump_drift() const { return pump_; }
   Conditioning conditioning() const { return ls_.conditioning(); }

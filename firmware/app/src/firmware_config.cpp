@@ -40,6 +40,9 @@ FirmwareConfig default_firmware_config(const ConverterLayout& conv, WindowPlan p
   // from a few nearby angles adds more than it removes (default run: ADB
   // 2.5 deg/h at the estimator's default 1e3, 0.15 deg/h at 10).
   f.estimator.pump.max_kappa_2 = 10.0;
+  // ... and only when its fitted gap harmonic is above the ideal electrode's
+  // noise (PumpDriftEstimator::Config::min_gap).
+  f.estimator.pump.min_gap = 2.0e-3;
   derive(f, conv);
   return f;
 }

@@ -25,14 +25,6 @@ class EstimatorPort final : public Identifier {
   }
   void add_control_sample(const ChainRecord& s) override;
   double control_drift_rad_s(double theta_a_rad) const override;
-  // The pump's gap part of D_Phi is used only when the fitted gap harmonic
-  // |eps| = 2 |(b1, b2)| / b0 is at least this: on an ideal electrode the
-  // fit leaves |eps| ~ 3e-4 (the default scenario, 1 h), whose D_Phi
-  // (nu |eps| / 2, 0.1-0.3 deg/h) is noise, not drift; a machined gap
-  // harmonic of 1e-2 drifts by ~10 deg/h.
-  void set_min_pump_gap(double eps) { min_pump_gap_ = eps; }
-  // The fitted |eps| (0 before the fit is usable).
-  double pump_gap() const;
 
   const est::Estimator& estimator() const { return est_; }
   uint32_t windows_accepted() const { return windows_ok_; }
@@ -46,7 +38,6 @@ class EstimatorPort final : public Identifier {
   // Control samples further apart than this (s) restart the D_Phi blocks.
   static constexpr double kMaxControlGapS = 0.0015;
   double last_control_t_s_ = -1.0;
-  double min_pump_gap_ = 2.0e-3;
   uint32_t windows_ok_ = 0;
   uint32_t windows_bad_ = 0;
   uint32_t solves_ok_ = 0;

@@ -6,6 +6,7 @@
 
 #include "firmware/angle_output.hpp"
 #include "firmware/can/command.hpp"
+#include "firmware/can/link.hpp"
 #include "firmware/can/telemetry.hpp"
 #include "firmware/executive.hpp"
 #include "firmware/fault_monitor.hpp"
@@ -63,9 +64,9 @@ class Gyro {
   static constexpr std::size_t kTaskCount = 7;
   // CAN command frames handled per command task run (the rest wait).
   static constexpr uint32_t kCommandsPerRun = 4;
-  // Command task runs spent bus-off before the CAN controller is restarted
-  // (0.1 s at 100 Hz, as can::CanLink: more than the 128 x 11 recessive bits
-  // the controller needs, and a faulty bus is not hammered).
+  // Command task runs spent bus-off before the link restarts the CAN
+  // controller (0.1 s at 100 Hz: more than the 128 x 11 recessive bits the
+  // controller needs, and a faulty bus is not hammered).
   static constexpr uint32_t kCanRestartRuns = 10;
   // Frames the output stays held after a commanded pattern move (longer than
   // the DAC and demodulator latency, a few frames).
@@ -100,9 +101,11 @@ class Gyro {
   const char* chain_error() const { return chain_.config_error(); }
   // CAN telemetry as last encoded (the snapshot the frames were made from).
   const can::TelemetrySnapshot& telemetry() const { return snapshot_; }
-  uint32_t can_tx_refused() const { return can_refused_; }
+  uint32_t can_tx_refused() const { return link_.stats().tx_refused; }
   // CAN controller restarts made after bus-off.
-  uint32_t can_restarts() const { return can_restarts_; }
+  uint32_t can_restarts() const { return link_.stats().restarts; }
+  // The firmware's CAN link (commands, telemetry, bus-off restart).
+  const can::CanLink& can_link() const { return link_; }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);
@@ -114,8 +117,8 @@ class Gyro {
   static void task_commands(Gyro& g);
 
   // CAN commands: accepted, refused (any reason), last result.
-  uint32_t commands_accepted() const { return cmd_accepted_; }
-  uint32_t commands_refused() const { return cmd_refused_; }
+  uint32_t commands_accepted() const { return link_.stats().commands_accepted; }
+  uint32_t commands_refused() const { return link_.stats().commands_refused; }
 
  private:
   void on_mode_change(Mode from, Mode to);
@@ -136,12 +139,7 @@ class Gyro {
   GyroStatus status_{};
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
-  uint32_t can_refused_ = 0;
-  uint32_t can_off_runs_ = 0;
-  uint32_t can_restarts_ = 0;
-  can::CommandValidator validator_{};
-  uint32_t cmd_accepted_ = 0;
-  uint32_t cmd_refused_ = 0;
+  can::CanLink link_;
   ChainCommands commands_{};
   std::array<hal::q31_t, kBlockFrames * hal::kAdcChannels> adc_{};
   std::array<hal::q31_t, kBlockFrames * hal::kDacChannels> dac_{};

@@ -40,7 +40,7 @@ class FakeChain final : public fw::SignalChain {
     out.wave.a_A = a_a_;
     out.wave.a_B = 0.0;
     out.wave.E = a_a_ * a_a_;
-    out.theta_A_rad = std::remainder(theta_, 1.5707963267948966);
+    out.theta_A_rad = theta_;  // unwrapped, as the chain gives it
     out.locked = locked;
     out.pump_v = cmd.pump_on ? 3.0 : 0.0;
   }
