@@ -7,6 +7,7 @@
 #include "campaign.hpp"
 #include "sim_tools/job.hpp"
 #include "sim_tools/report.hpp"
+#include "sim_tools/table_schedule.hpp"
 
 namespace hrg::audit::bench {
 
@@ -14,33 +15,23 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
-constexpr double kRingUpS = 45.0;  // ring-up from rest and lock (the main job's first hold)
-constexpr double kRampS = 1.0;     // the table's acceleration ramps
+constexpr double kRampS = 1.0;  // the table's acceleration ramps
 
-// Case angle of the table's turn: the pattern (at -K/2 of it) goes twice
-// through the 4 theta circle, 180 deg of theta.
-double turn_case_rad(const Scenario& s) {
-  return 2.0 * (kPi / 2.0) * 2.0 / s.resonator.angular_gain;
-}
-
-// Cruise time of that turn at the scenario's table rate.
+// Cruise time of the main job's sweep at the scenario's table rate.
 double cruise_s(const Scenario& s) {
-  return turn_case_rad(s) / std::abs(s.sweep_rate_dps * kDeg) - kRampS;
+  return simtools::sweep_case_rad(s.resonator.angular_gain) / std::abs(s.sweep_rate_dps * kDeg) -
+         kRampS;
 }
 
-// The table: still while the firmware rings up, then one turn of the case
-// that takes the pattern twice through the 4 theta circle (the main job's
-// sweep), then still again.
+// The table: still while the firmware rings up, then the main job's sweep
+// (the pattern twice through the 4 theta circle) in the scenario's
+// direction, then still again.
 sim::Profile sweep_profile(const Scenario& s, double earth_rad_s) {
   const double rate = s.sweep_rate_dps * kDeg;
-  const double t0 = kRingUpS;
-  const double cruise = cruise_s(s);
-  return sim::Profile::ramps({{0.0, 0.0},
-                              {t0, 0.0},
-                              {t0 + kRampS, rate},
-                              {t0 + kRampS + cruise, rate},
-                              {t0 + 2.0 * kRampS + cruise, 0.0}})
-      .add_offset(earth_rad_s);
+  simtools::TableSchedule sch;
+  sch.hold(simtools::kRingUpS);
+  sch.turn(std::copysign(simtools::sweep_case_rad(s.resonator.angular_gain), rate), rate, kRampS);
+  return sch.profile(earth_rad_s);
 }
 
 simtools::JobConfig firmware_job(const Scenario& s) {
@@ -73,7 +64,7 @@ simtools::JobConfig firmware_job(const Scenario& s) {
 }  // namespace
 
 double firmware_duration_s(const Scenario& s) {
-  return kRingUpS + cruise_s(s) + 2.0 * kRampS + 10.0;
+  return simtools::kRingUpS + cruise_s(s) + 2.0 * kRampS + 10.0;
 }
 
 recording::Recording simulate_firmware(const Scenario& s) {

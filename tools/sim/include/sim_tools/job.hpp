@@ -168,6 +168,10 @@ struct RunOptions {
 // deadline misses are counted and the real-time setup is reported.
 JobResult run_job(const JobConfig& job, const RunOptions& options);
 
+// Fills the figures of `r` from its rows (errors against the truth, the
+// parked-angle bias and its fits, the Allan deviation on a still table).
+void analyse_run(JobResult& r, const JobConfig& job);
+
 // The true drift D (rad/s, Omega K units) of the resonator at pattern angle
 // theta with quadrature ratio a_B/a_A (physics.md section 3, D_nu + D_w).
 double true_drift_rad_s(const sim::ResonatorParams& p, double theta_rad, double ab_over_aa);

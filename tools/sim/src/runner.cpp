@@ -1,0 +1,349 @@
+// SPDX-License-Identifier: MIT
+// The main job's runner: the firmware (firmware/app) on the simulated target,
+// in lockstep or paced in real time, with faults injected through the
+// target's back door and one telemetry row per 1 / telemetry_hz.
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <memory>
+#include <numbers>
+#include <stdexcept>
+
+#include "can/candump_log.hpp"
+#include "firmware/app/firmware.hpp"
+#include "hal/linux/linux_clock.hpp"
+#include "hal/linux/realtime.hpp"
+#include "sim_target/control.hpp"
+#include "sim_tools/console.hpp"
+#include "sim_tools/job.hpp"
+
+namespace hrg::simtools {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
+
+// The true state half-way between two instants (slow quantities, linear).
+sim::TrueState midpoint(const sim::TrueState& a, const sim::TrueState& b) {
+  sim::TrueState m = a;
+  m.t_s = 0.5 * (a.t_s + b.t_s);
+  m.pattern_angle_rad = 0.5 * (a.pattern_angle_rad + b.pattern_angle_rad);
+  m.input_angle_rad = 0.5 * (a.input_angle_rad + b.input_angle_rad);
+  m.energy_v2 = 0.5 * (a.energy_v2 + b.energy_v2);
+  m.a_a_v = 0.5 * (a.a_a_v + b.a_a_v);
+  m.a_b_v = 0.5 * (a.a_b_v + b.a_b_v);
+  m.rate_rad_s = 0.5 * (a.rate_rad_s + b.rate_rad_s);
+  m.temp_c = 0.5 * (a.temp_c + b.temp_c);
+  return m;
+}
+
+// The boards and clocks the firmware runs on: in lockstep the simulated
+// board's clock paces (it returns at once) and a host clock times the tasks;
+// in real time CLOCK_MONOTONIC does both, with the simulated converters
+// behind it.
+struct Rig {
+  HostClock host_timer;
+  hal::linux_board::LinuxClock rt_clock;
+  hal::Board& sim_board = hal::board();  // the simulated target, chosen at link time
+  hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
+                      sim_board.fault_input, sim_board.can, rt_clock};
+};
+
+std::unique_ptr<fw::app::Firmware> build_firmware(const JobConfig& job, Rig& rig,
+                                                  const RunOptions& opt, JobResult& r) {
+  r.real_time = opt.real_time;
+  if (opt.real_time) {
+    hal::linux_board::RealtimeRequest req;
+    req.priority = opt.rt_priority;
+    char buf[200];
+    r.realtime_setup =
+        hal::linux_board::describe(hal::linux_board::setup_realtime(req), buf, sizeof buf);
+  }
+  // The firmware is large (the chain holds its filters): on the heap here,
+  // statically allocated on a board.
+  auto firmware = opt.real_time
+                      ? std::make_unique<fw::app::Firmware>(rig.rt_board, rig.rt_clock,
+                                                            fw::Pacing::real_time, job.firmware)
+                      : std::make_unique<fw::app::Firmware>(rig.sim_board, rig.host_timer,
+                                                            fw::Pacing::lockstep, job.firmware);
+  if (const char* err = firmware->chain().error())
+    throw std::invalid_argument(std::string("signal chain configuration: ") + err);
+  if (const char* err = firmware->error()) throw std::invalid_argument(err);
+  return firmware;
+}
+
+// Applies the faults due by time t_s through the target's back door.
+void inject_faults(const JobConfig& job, double t_s, std::size_t& next, sim::SimTarget& target,
+                   JobResult& r) {
+  while (next < job.faults.size() && job.faults[next].t_s <= t_s) {
+    const FaultEvent& e = job.faults[next++];
+    switch (e.kind) {
+      case FaultEvent::Kind::adc_stuck: target.set_adc_stuck(e.channel, e.on); break;
+      case FaultEvent::Kind::adc_saturated: target.set_adc_saturated(e.channel, e.on); break;
+      case FaultEvent::Kind::dac_dead: target.set_dac_dead(e.channel, e.on); break;
+      case FaultEvent::Kind::fault_input: target.set_fault_input(e.on); break;
+      case FaultEvent::Kind::can_bus_off:
+        target.can().force_bus_off();
+        r.t_can_back_s = -1.0;
+        break;
+    }
+  }
+}
+
+// Mode changes, faults, convergence and the CAN's return after a bus-off.
+void track_events(const fw::Gyro& gyro, sim::SimTarget& target, fw::Mode& last_mode, JobResult& r) {
+  const fw::GyroStatus& st = gyro.status();
+  const double t_s = st.chain.t_s;
+  if (st.mode != last_mode) {
+    ++r.mode_changes;
+    if ((st.mode == fw::Mode::fault || st.mode == fw::Mode::safe) && r.t_first_fault_s < 0) {
+      r.t_first_fault_s = t_s;
+    }
+    if (st.mode == fw::Mode::operate && r.t_first_fault_s >= 0 && r.t_back_operate_s < 0) {
+      r.t_back_operate_s = t_s;
+    }
+    last_mode = st.mode;
+  }
+  r.faults_seen = static_cast<uint16_t>(r.faults_seen | st.faults);
+  if (r.t_converged_s < 0 && gyro.scheduler().campaign_done()) r.t_converged_s = t_s;
+  if (st.mode == fw::Mode::operate && !r.reached_operate) {
+    r.reached_operate = true;
+    r.t_operate_s = t_s;
+  }
+  if (r.t_can_back_s < 0 && !target.can().sent().empty() &&
+      target.can().counters().bus_off_events > 0) {
+    r.t_can_back_s = t_s;
+  }
+}
+
+// Counts (and logs, when asked) the frames the firmware put on the bus.
+void drain_can(sim::SimTarget& target, can::CandumpLogWriter* log, double t_s, JobResult& r) {
+  auto& bus = target.can();
+  if (log) {
+    for (const auto& f : bus.sent())
+      log->write(f, static_cast<uint64_t>(t_s * 1e9));
+  }
+  r.can_frames += bus.sent().size();
+  bus.clear_sent();
+}
+
+// Telemetry rows stamped at the centre of the demodulator's window, where
+// the envelope is: the NCO's offset from the fixed reference and the true
+// state at the last three block ends, and whether the drive was off long
+// enough that the row's whole averaging span is free of it.
+class RowStamper {
+ public:
+  explicit RowStamper(const JobConfig& job) : f_ref_hz_(job.firmware.chain.f_center_hz) {
+    // A row is free of any drive once the last driven DAC word (played
+    // dac_lead_frames + the DAC's pipeline latency after its block) lies
+    // before the 3 L - 2 samples the demodulator averages.
+    const double l = static_cast<double>(job.firmware.chain.block_frames);
+    drive_free_blocks_ = static_cast<uint64_t>(
+        1.0 + std::ceil((job.firmware.chain.dac_lead_frames +
+                         static_cast<double>(job.sim.dac.latency_samples) + 2.0 * l - 2.0) /
+                        l));
+    off_blocks_ = drive_free_blocks_;
+  }
+
+  void after_block(const fw::app::Firmware& firmware, const sim::SimTarget& target) {
+    const fw::GyroStatus& st = firmware.gyro().status();
+    off_blocks_ = st.excitation_on ? 0 : off_blocks_ + 1;
+    // NCO phase at the first sample after this block (time t_s) against the
+    // fixed reference 2 pi f_ref t.
+    const double nco_cycles = static_cast<double>(firmware.chain().chain().nco_phase()) * 0x1p-32;
+    const double ref_cycles = std::fmod(f_ref_hz_ * st.chain.t_s, 1.0);
+    ref_offset_[2] = ref_offset_[1];
+    ref_offset_[1] = ref_offset_[0];
+    ref_offset_[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
+    truth_[2] = truth_[1];
+    truth_[1] = truth_[0];
+    truth_[0] = target.true_state();
+  }
+
+  // The decimating filter's output is centred 1.5 L - 1 samples before the
+  // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
+  // states one and two blocks back. Stamped at the block end instead, a rate
+  // ramp of 10 deg/s^2 puts a 0.015 deg/s error into the input rate the
+  // envelope saw, which the audit takes for a pickoff gain mismatch.
+  sim::TrueState truth() const { return midpoint(truth_[1], truth_[2]); }
+  double ref_offset_rad() const {
+    return ref_offset_[1] + 0.5 * std::remainder(ref_offset_[2] - ref_offset_[1], 2.0 * kPi);
+  }
+  bool drive_free() const { return off_blocks_ >= drive_free_blocks_; }
+
+ private:
+  double f_ref_hz_;
+  uint64_t drive_free_blocks_ = 0;
+  uint64_t off_blocks_ = 0;  // blocks since the excitation was last on
+  double ref_offset_[3] = {0.0, 0.0, 0.0};
+  sim::TrueState truth_[3];
+};
+
+// Angles are compared from the first valid output on.
+struct AngleReference {
+  bool set = false;
+  double true_rad = 0.0, out_rad = 0.0, raw_rad = 0.0;
+};
+
+void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const RowStamper& stamp,
+                const AngleReference& ref) {
+  const fw::GyroStatus& st = g.status();
+  const fw::ChainRecord& ch = st.chain;
+  const sim::TrueState ts = stamp.truth();
+  const double k = job.firmware.gyro.angular_gain;
+  Row row{};
+  row.t_s = ts.t_s;
+  // The chain demodulates against its NCO, whose phase the PLL moves every
+  // block. The recording's cx..sy are against the fixed metadata reference
+  // (ph = 2 pi f_ref t): x = Re((cx - i sx) e^(i ph_nco)) = Re((cx' - i sx')
+  // e^(i ph)) with cx' - i sx' = (cx - i sx) e^(i (ph_nco - ph)).
+  const double c = std::cos(stamp.ref_offset_rad());
+  const double s = std::sin(stamp.ref_offset_rad());
+  row.cx_v = ch.quad.cx * c + ch.quad.sx * s;
+  row.sx_v = ch.quad.sx * c - ch.quad.cx * s;
+  row.cy_v = ch.quad.cy * c + ch.quad.sy * s;
+  row.sy_v = ch.quad.sy * c - ch.quad.cy * s;
+  row.exc = stamp.drive_free() ? 0 : 1;
+  row.excitation_cmd = st.excitation_on ? 1 : 0;
+  row.pump_v = ch.pump_v;
+  row.temp_c = ts.temp_c;
+  row.rate_dps = ts.rate_rad_s / kDeg;
+  row.pll_hz = ch.pll_freq_hz;
+  row.quad_v = ch.wave.a_B;
+  row.mode = static_cast<int>(st.mode);
+  row.theta_deg = st.theta_unwrapped_rad / kDeg;
+  row.out_angle_deg = (st.out_angle_rad - ref.out_rad) / kDeg;
+  row.raw_angle_deg = (st.out_raw_angle_rad - ref.raw_rad) / kDeg;
+  row.true_angle_deg = (ts.input_angle_rad - ref.true_rad) / kDeg;
+  row.true_theta_deg = ts.pattern_angle_rad / kDeg;
+  row.a_a_v = ch.wave.a_A;
+  row.a_b_v = ch.wave.a_B;
+  row.drift_model_dph = st.drift_rad_s / k * kRadSToDph;
+  row.drift_control_dph = st.control_drift_rad_s / k * kRadSToDph;
+  const double q = ts.a_a_v > 0 ? ts.a_b_v / ts.a_a_v : 0.0;
+  row.drift_true_dph =
+      true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) / k * kRadSToDph;
+  row.out_valid = st.out_valid ? 1 : 0;
+  row.pattern_cmd = st.pattern_control ? 1 : 0;
+  r.rows.push_back(row);
+}
+
+void summarise_executive(JobResult& r, const fw::Gyro& g) {
+  const auto& ex = g.executive();
+  for (std::size_t i = 0; i < fw::Gyro::kTaskCount; ++i) {
+    const auto& t = ex.task(i);
+    const auto& s = ex.task_stats()[i];
+    TaskFigures f;
+    f.name = t.name;
+    f.rate_hz = t.rate_hz;
+    f.budget_ns = t.budget_ns;
+    f.min_ns = s.runs ? s.min_ns : 0;
+    f.max_ns = s.max_ns;
+    f.mean_ns = s.runs ? static_cast<double>(s.total_ns) / static_cast<double>(s.runs) : 0.0;
+    f.overruns = s.overruns;
+    f.slips = s.slips;
+    f.runs = s.runs;
+    r.tasks.push_back(f);
+  }
+  r.frames = ex.frame_stats();
+}
+
+// What the firmware identified, against the truth and the Cramer-Rao bound.
+void summarise_identification(JobResult& r, const JobConfig& job,
+                              const fw::app::Firmware& firmware) {
+  const fw::Gyro& gyro = firmware.gyro();
+  const fw::EstimatorPort& ident = firmware.estimator();
+  r.excitation_off_fraction = gyro.scheduler().excitation_off_fraction();
+  r.windows = gyro.scheduler().windows();
+  r.windows_accepted = ident.windows_accepted();
+  r.campaign_done = gyro.scheduler().campaign_done();
+  r.identification = ident.identification();
+  r.truth = true_parameters(job.sim.resonator);
+  r.condition = ident.health().condition;
+  r.coverage = ident.health().coverage;
+  // Per-sample amplitude noise at the control rate: the pickoff noise (white,
+  // sigma per ADC sample) mixed by 2 cos and low-passed to one sample per
+  // block has the low-frequency density of a white sequence of variance
+  // 2 sigma^2 / L at the block rate; a_A and a_B are unit-norm projections of
+  // the x and y quadratures.
+  const double adc_sigma_v =
+      std::sqrt(0.5 * (job.sim.adc.noise_v_rms[0] * job.sim.adc.noise_v_rms[0] +
+                       job.sim.adc.noise_v_rms[1] * job.sim.adc.noise_v_rms[1]));
+  r.noise_sigma_v =
+      adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.firmware.chain.block_frames));
+  const est::ParamMatrix crb = ident.estimator().cramer_rao_bound(r.noise_sigma_v);
+  for (int i = 0; i < est::kParams; ++i) {
+    r.crb_sigma[static_cast<std::size_t>(i)] = crb(i, i) > 0.0 ? std::sqrt(crb(i, i)) : 0.0;
+  }
+}
+
+// Speed of the run: wall and CPU time, the share spent in the simulation.
+void summarise_speed(JobResult& r, const fw::Gyro& gyro, uint64_t frames, double wall_s,
+                     double cpu_s) {
+  r.wall_s = wall_s;
+  r.cpu_s = cpu_s;
+  r.realtime_factor = r.wall_s > 0 ? r.sim_s / r.wall_s : 0.0;
+  r.realtime_factor_cpu = r.cpu_s > 0 ? r.sim_s / r.cpu_s : 0.0;
+  const auto adc_wait_ns = static_cast<double>(gyro.status().adc_wait_ns);
+  r.adc_wait_mean_us = frames ? adc_wait_ns * 1e-3 / static_cast<double>(frames) : 0.0;
+  r.sim_share = r.wall_s > 0 ? adc_wait_ns * 1e-9 / r.wall_s : 0.0;
+}
+
+}  // namespace
+
+JobResult run_job(const JobConfig& job, const RunOptions& opt) {
+  JobResult r;
+  sim::SimTarget& target = sim::target();
+  target.configure(job.sim);
+  Rig rig;
+  const std::unique_ptr<fw::app::Firmware> firmware = build_firmware(job, rig, opt, r);
+  const fw::Gyro& gyro = firmware->gyro();
+  std::unique_ptr<can::CandumpLogWriter> log;
+  if (!opt.can_log.empty()) log = std::make_unique<can::CandumpLogWriter>(opt.can_log, "can0");
+
+  const auto frames = static_cast<uint64_t>(std::llround(job.duration_s * fw::kBaseRateHz));
+  const auto row_every =
+      static_cast<uint64_t>(std::max(1.0, std::round(fw::kBaseRateHz / job.telemetry_hz)));
+  r.rows.reserve(frames / row_every + 1);
+  ProgressBar bar(static_cast<double>(frames), opt.progress);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  std::size_t next_fault = 0;
+  fw::Mode last_mode = fw::Mode::power_up;
+  RowStamper stamp(job);
+  AngleReference ref;
+  for (uint64_t k = 0; k < frames; ++k) {
+    inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
+    firmware->run_frame();
+    const fw::GyroStatus& st = gyro.status();
+    stamp.after_block(*firmware, target);
+    track_events(gyro, target, last_mode, r);
+    drain_can(target, log.get(), st.chain.t_s, r);
+    if (k % row_every != 0 || k < 2) continue;  // rows from a full history on
+    if (!ref.set && st.out_valid) {
+      ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};
+    }
+    record_row(r, job, gyro, stamp, ref);
+    if (opt.progress && k % 1000 == 0) {
+      bar.update(static_cast<double>(k),
+                 fmt("t=%.0f s %s", st.chain.t_s, fw::to_string(st.mode)).c_str());
+    }
+  }
+  bar.finish();
+  r.sim_s = job.duration_s;
+  summarise_speed(r, gyro, frames,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(),
+                  static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
+  r.final_mode = gyro.status().mode;
+  r.can_bus_off_events = target.can().counters().bus_off_events;
+  r.can_restarts = gyro.can_restarts();
+  summarise_identification(r, job, *firmware);
+  summarise_executive(r, gyro);
+  if (log) log->flush();
+  analyse_run(r, job);
+  return r;
+}
+
+}  // namespace hrg::simtools
