@@ -2,6 +2,7 @@
 #include "sim_tools/report.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <fstream>
 #include <stdexcept>
 
@@ -12,7 +13,7 @@
 namespace hrg::simtools {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 constexpr const char* kParamNames[5] = {"nu_per_s", "dnu_c_per_s", "dnu_s_per_s", "dw_c_rad_s",
                                         "dw_s_rad_s"};
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
