@@ -35,6 +35,8 @@ constexpr const char* kUsage =
     "from 1800 s on, 5 s windows while the table turns until 800 s come first.\n"
     "--static-base: no rate table; the firmware turns the pattern on purpose\n"
     "(pattern-angle command) to fill the 4 theta bins between windows.\n"
+    "Every option combines with --scenario FILE or is refused with the reason\n"
+    "(--static-base or --bias-angles with a scenario's own rate profile).\n"
     "--real-time paces the same executive by CLOCK_MONOTONIC (1 ms frames,\n"
     "SCHED_FIFO and mlockall when permitted) and counts deadline misses.\n"
     "--no-control-drift leaves the control-loop drift D_Phi out of the output\n"
@@ -58,7 +60,7 @@ std::filesystem::path plots_script() {
 int sim_main(std::span<char* const> args) {
   std::string scenario, out_dir = "sim-out", can_log;
   double duration_s = 0.0;
-  int bias_angles = 16;
+  int bias_angles = 0;  // not given: the schedule's default
   bool plots = true, quiet = false, real_time = false, static_base = false;
   bool control_drift = true;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -119,13 +121,7 @@ int sim_main(std::span<char* const> args) {
 
   simtools::JobConfig job;
   try {
-    if (!scenario.empty()) {
-      job = simtools::job_from_scenario(scenario, duration_s, bias_angles);
-    } else if (static_base) {
-      job = simtools::static_base_job(duration_s);
-    } else {
-      job = simtools::default_job(duration_s, bias_angles);
-    }
+    job = simtools::make_job(scenario, {duration_s, bias_angles, static_base});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
