@@ -2,6 +2,7 @@
 #include "sim_target/scenario.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -307,10 +308,35 @@ void read_can(Section s, SimConfig& c) {
   s.finish();
 }
 
+// toml++ 3.3.0 (Debian 12) reaches __builtin_unreachable on some non-ASCII
+// code points where it looks for whitespace (upstream marzer/tomlplusplus#295,
+// found by our fuzzer): undefined behaviour, not an error. Every key and value
+// of a scenario is ASCII, so a non-ASCII byte is refused before parsing.
+void require_ascii(std::string_view text, const std::string& source) {
+  std::size_t line = 1, column = 1;
+  for (const char ch : text) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (byte >= 0x80) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02x", byte);
+      throw ScenarioError(source + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                          ": non-ASCII byte " + hex +
+                          ": scenario files are ASCII, comments included (write deg, degC, uV)");
+    }
+    if (ch == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+}
+
 }  // namespace
 
 SimConfig parse_scenario(std::string_view toml_text, const std::string& source,
                          const std::string& base_dir) {
+  require_ascii(toml_text, source);
   toml::table root;
   try {
     root = toml::parse(toml_text, source);

@@ -217,3 +217,77 @@ TEST(SharedExamples, LabRingDownCampaignReadsWhole) {
   DOUBLES_EQUAL(0.005, r.typical_step_s(), 1e-9);
   CHECK(r.has_column("rate_dps"));
 }
+
+TEST_GROUP(RecordingGzip){
+    // A 500-row recording written gzip-compressed; its bytes.
+    std::string gz_bytes(){
+        Recording r({"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc"}, 5000.0, 0.554);
+for (int k = 0; k < 500; ++k) {
+  const double t = 0.002 * (k + 1);
+  r.append_row({t, std::cos(t), std::sin(3 * t) / 7.0, 1e-7 * k, -2.5e-9 * k, 0.0});
+}
+const fs::path p = temp_path("gz_src.csv.gz");
+hrg::recording::write_recording(p, r);
+std::ifstream in(p, std::ios::binary);
+std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+fs::remove(p);
+return bytes;
+}
+// read_recording's error for a file holding `bytes`, named `name`.
+std::string read_error(const std::string& bytes, const std::string& name) {
+  const fs::path p = temp_path(name);
+  std::ofstream(p, std::ios::binary) << bytes;
+  std::string what;
+  try {
+    hrg::recording::read_recording(p);
+    what = "no error";
+  } catch (const RecordingError& e) {
+    LONGS_EQUAL(0, e.line());  // a stream error, not a line of the text
+    what = e.what();
+  }
+  fs::remove(p);
+  return what;
+}
+static bool has(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+}
+;
+
+TEST(RecordingGzip, TruncatedStreamIsReportedAsTruncatedNamingTheFile) {
+  const std::string gz = gz_bytes();
+  // Inside the header, inside the deflate data, and short of the 8-byte
+  // trailer (CRC-32 and length) by one byte.
+  for (const std::size_t keep : {std::size_t{5}, gz.size() / 2, gz.size() - 1}) {
+    const std::string what = read_error(gz.substr(0, keep), "cut.csv.gz");
+    CHECK_TEXT(has(what, "truncated gzip stream"), what.c_str());
+    CHECK_TEXT(has(what, "cut.csv.gz"), what.c_str());
+    CHECK_TEXT(has(what, "after " + std::to_string(keep) + " compressed bytes"), what.c_str());
+    CHECK_TEXT(!has(what, "first line"), what.c_str());
+  }
+}
+
+TEST(RecordingGzip, CorruptDataIsReportedAsCorruptNamingTheFile) {
+  std::string gz = gz_bytes();
+  gz[gz.size() - 6] ^= 0x5a;  // inside the CRC-32 of the trailer
+  std::string what = read_error(gz, "crc.csv.gz");
+  CHECK_TEXT(has(what, "corrupt gzip data"), what.c_str());
+  CHECK_TEXT(has(what, "crc.csv.gz"), what.c_str());
+  CHECK_TEXT(has(what, "incorrect data check"), what.c_str());
+  gz = gz_bytes();
+  gz[3] = static_cast<char>(0xe0);  // reserved header flag bits
+  what = read_error(gz, "flags.csv.gz");
+  CHECK_TEXT(has(what, "corrupt gzip data at compressed byte"), what.c_str());
+  CHECK_TEXT(has(what, "flags.csv.gz"), what.c_str());
+}
+
+TEST(RecordingGzip, ConcatenatedMembersReadAsOneText) {
+  const std::string gz = gz_bytes();
+  const std::string text = hrg::recording::gunzip(gz, "one");
+  CHECK(text.rfind("# hrg-recording v1\n", 0) == 0);
+  // Two members in a row (as `cat a.gz b.gz` makes) are one text.
+  STRCMP_EQUAL((text + text).c_str(), hrg::recording::gunzip(gz + gz, "two").c_str());
+  // Bytes after the last member that start no member are corrupt, not ignored.
+  const std::string what = read_error(gz + "xyz", "tail.csv.gz");
+  CHECK_TEXT(has(what, "corrupt gzip data"), what.c_str());
+}

@@ -35,6 +35,8 @@ constexpr const char* kUsage =
     "from 1800 s on, 5 s windows while the table turns until 800 s come first.\n"
     "--static-base: no rate table; the firmware turns the pattern on purpose\n"
     "(pattern-angle command) to fill the 4 theta bins between windows.\n"
+    "Every option combines with --scenario FILE or is refused with the reason\n"
+    "(--static-base or --bias-angles with a scenario's own rate profile).\n"
     "--real-time paces the same executive by CLOCK_MONOTONIC (1 ms frames,\n"
     "SCHED_FIFO and mlockall when permitted) and counts deadline misses.\n"
     "--no-control-drift leaves the control-loop drift D_Phi out of the output\n"
@@ -56,7 +58,7 @@ std::filesystem::path plots_script() {
 struct SimOptions {
   std::string scenario, out_dir = "sim-out", can_log;
   double duration_s = 0.0;
-  int bias_angles = 16;
+  int bias_angles = 0;  // not given: the schedule's default
   bool plots = true, quiet = false, real_time = false, static_base = false;
   bool control_drift = true;
 };
@@ -116,14 +118,8 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
 
 // The job the options ask for (throws on a bad scenario).
 simtools::JobConfig make_job(const SimOptions& o) {
-  simtools::JobConfig job;
-  if (!o.scenario.empty()) {
-    job = simtools::job_from_scenario(o.scenario, o.duration_s, o.bias_angles);
-  } else if (o.static_base) {
-    job = simtools::static_base_job(o.duration_s);
-  } else {
-    job = simtools::default_job(o.duration_s, o.bias_angles);
-  }
+  simtools::JobConfig job =
+      simtools::make_job(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
   job.firmware.gyro.compensate_control_drift = o.control_drift;
   return job;
 }

@@ -3,6 +3,7 @@
 # Installs the Debian 12 packages a profile needs, only those missing.
 #   tools/setup/deps.sh sim    build the host CLI and run the simulated gyro
 #   tools/setup/deps.sh test   everything CI builds and runs (cross, bare metal, kernel VM)
+#   tools/setup/deps.sh --list PROFILE   prints the profile's packages, one a line
 # As root it runs apt-get; otherwise it prints the exact apt-get line and stops.
 set -euo pipefail
 
@@ -12,16 +13,19 @@ test_pkgs=(clang clang-format libclang-rt-14-dev valgrind can-utils gpiod libgpi
   python3-can g++-aarch64-linux-gnu g++-arm-linux-gnueabihf libc6-dev-arm64-cross
   libc6-dev-armhf-cross qemu-user qemu-system-arm qemu-system-x86 gcc-arm-none-eabi
   libstdc++-arm-none-eabi-newlib linux-image-amd64 linux-headers-amd64 linux-source-6.1
-  busybox-static cpio kmod xz-utils make iproute2)
+  busybox-static cpio kmod xz-utils make iproute2 debootstrap)
 # Target libraries for the Linux board tests (Debian multiarch).
 cross_pkgs=(libcpputest-dev:arm64 libcpputest-dev:armhf libgpiod-dev:arm64 libgpiod-dev:armhf)
 
+list_only=0
+if [ "${1:-}" = --list ]; then list_only=1; shift; fi
 profile=${1:-}
 case "$profile" in
   sim) wanted=("${host_pkgs[@]}") ;;
   test) wanted=("${host_pkgs[@]}" "${test_pkgs[@]}" "${cross_pkgs[@]}") ;;
-  *) echo "usage: $0 sim|test" >&2; exit 2 ;;
+  *) echo "usage: $0 [--list] sim|test" >&2; exit 2 ;;
 esac
+if [ "$list_only" -eq 1 ]; then printf '%s\n' "${wanted[@]}"; exit 0; fi
 
 is_installed() {
   dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q '^install ok installed'

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # libFuzzer (Debian's clang) with AddressSanitizer and UndefinedBehaviorSanitizer
-# on the CAN command decoder, the candump -l log reader and the DBC parser, for
-# a bounded time each (HRG_FUZZ_SECONDS, default 30). Fails on any crash,
+# on the CAN command decoder, the candump -l log reader, the DBC parser, the
+# hrg-recording reader (CSV and gzip) and the scenario (TOML) reader, for a
+# bounded time each (HRG_FUZZ_SECONDS, default 30). Fails on any crash,
 # sanitizer finding or broken invariant. Seeds are the protocol's own frames
-# and files; findings are kept in build/fuzz/ for reproduction.
+# and files, the shared example recordings (HRG_SHARED_DIR, default ../shared;
+# a recording the main job writes when they are absent) and the scenario
+# library; findings are kept in build/fuzz/ for reproduction.
 set -euo pipefail
 seconds=${HRG_FUZZ_SECONDS:-30}
 out=${HRG_FUZZ_DIR:-build/fuzz}
@@ -21,6 +24,19 @@ clang++ "${flags[@]}" tests/fuzz/fuzz_candump_reader.cpp tools/can/candump_log.c
 clang++ "${flags[@]}" tests/fuzz/fuzz_dbc_parser.cpp tools/can/dbc.cpp \
   -o "$out/fuzz_dbc_parser" &
 wait %1 && wait %2 && wait %3
+clang++ "${flags[@]}" -Itools/recording/include tests/fuzz/fuzz_recording_reader.cpp \
+  tools/recording/src/recording.cpp tools/recording/src/recording_writer.cpp -lz \
+  -o "$out/fuzz_recording_reader" &
+# toml++ 3.3.0 (Debian 12) asserts a precondition in parse_key that a malformed
+# table header ('[[[1]]]', '[\v]') breaks (upstream marzer/tomlplusplus#301);
+# the shipped g++ Release build has no such assertion and reports the parse
+# error (CTest hrg_scenario_check_rejects_bad_table_header). The target is
+# built the same way: toml++'s own assertions off, everything else checked.
+clang++ "${flags[@]}" -Isim_target/include -I/usr/include/eigen3 \
+  '-DTOML_ASSERT(expr)=static_assert(true)' \
+  tests/fuzz/fuzz_scenario_reader.cpp sim_target/src/scenario.cpp sim_target/src/profile.cpp \
+  -o "$out/fuzz_scenario_reader" &
+wait %1 && wait %2
 
 # Seeds.
 mkdir -p "$out/seed-command" "$out/seed-candump" "$out/seed-dbc"
@@ -31,6 +47,28 @@ printf '\x03\x00\x00\x80\x04\x80\x82\x01\x00\x00\x00\x00\x00\x00\x00\x02\x80\x86
 printf '(0000000001.000000) can0 100#0102030405060708\n(0000000001.000500) can0 090#84103002\n(1.5) can0 20000040#0000000000000000\n(2.0) can1 1ABCDEF0#R\n' \
   > "$out/seed-candump/log"
 cp firmware/can/hrg.dbc "$out/seed-dbc/hrg.dbc"
+# Recordings: the head of each shared example as CSV, gzip and cut gzip (the
+# whole files are larger than -max_len).
+mkdir -p "$out/seed-recording" "$out/seed-scenario"
+shared=${HRG_SHARED_DIR:-../shared}/examples
+examples=("$shared"/*.csv.gz)
+if [ ! -e "${examples[0]}" ]; then
+  echo "fuzz: no shared examples in $shared; seeding from a main-job recording"
+  tools/ci/preset.sh host --no-test --target hrg >/dev/null
+  build/host/bin/hrg sim --duration 2 --out "$out/sim-seed" --no-plots --quiet || true
+  gzip -c "$out/sim-seed/telemetry.csv" >"$out/sim-seed/telemetry.csv.gz"
+  examples=("$out/sim-seed/telemetry.csv.gz")
+fi
+for f in "${examples[@]}"; do
+  n=$(basename "$f" .csv.gz)
+  { zcat "$f" || true; } | head -n 30 >"$out/seed-recording/$n.csv"
+  gzip -9 -c "$out/seed-recording/$n.csv" >"$out/seed-recording/$n.csv.gz"
+  head -c 200 "$out/seed-recording/$n.csv.gz" >"$out/seed-recording/$n-cut.csv.gz"
+done
+# Scenarios: the library, without the comments' slashes (see the target).
+for f in sim_target/scenarios/*.toml; do
+  tr -d '/' <"$f" >"$out/seed-scenario/$(basename "$f")"
+done
 
 fail=0
 run() {  # run NAME SEED_DIR SECONDS
@@ -49,4 +87,6 @@ run() {  # run NAME SEED_DIR SECONDS
 run fuzz_command_decoder "$out/seed-command" "$seconds"
 run fuzz_candump_reader "$out/seed-candump" "$seconds"
 run fuzz_dbc_parser "$out/seed-dbc" "$(( (seconds + 1) / 2 ))"
+run fuzz_recording_reader "$out/seed-recording" "$seconds"
+run fuzz_scenario_reader "$out/seed-scenario" "$seconds"
 exit $fail

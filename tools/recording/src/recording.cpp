@@ -68,31 +68,51 @@ std::string read_file_bytes(const std::filesystem::path& path) {
   if (!in) throw RecordingError(name, 0, "", "cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  std::string raw = ss.str();
-  const bool gz = raw.size() >= 2 && static_cast<unsigned char>(raw[0]) == 0x1f &&
-                  static_cast<unsigned char>(raw[1]) == 0x8b;
-  if (!gz) return raw;
-  gzFile f = gzopen(name.c_str(), "rb");
-  if (f == nullptr) throw RecordingError(name, 0, "", "cannot open the gzip stream");
-  std::string text;
-  text.reserve(raw.size() * 3);
-  std::vector<char> buf(1 << 16);
-  while (true) {
-    const int n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()));
-    if (n < 0) {
-      int err = 0;
-      const std::string why = gzerror(f, &err);
-      gzclose(f);
-      throw RecordingError(name, 0, "", "corrupt gzip data (" + why + ")");
-    }
-    if (n == 0) break;
-    text.append(buf.data(), static_cast<std::size_t>(n));
-  }
-  gzclose(f);
-  return text;
+  if (in.bad()) throw RecordingError(name, 0, "", "read error");
+  return ss.str();
 }
 
 }  // namespace
+
+bool is_gzip(std::string_view bytes) {
+  return bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f &&
+         static_cast<unsigned char>(bytes[1]) == 0x8b;
+}
+
+std::string gunzip(std::string_view bytes, const std::string& source) {
+  z_stream z{};
+  // 16 + MAX_WBITS: gzip framing only (header, CRC-32 and length checked).
+  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK)
+    throw RecordingError(source, 0, "", "cannot start the gzip decoder");
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.avail_in = static_cast<uInt>(bytes.size());
+  std::string text;
+  char buf[1 << 15];
+  int rc = Z_OK;
+  // One member after another (concatenated gzip files are one stream).
+  while (rc != Z_STREAM_END || z.avail_in > 0) {
+    if (rc == Z_STREAM_END) inflateReset(&z);
+    z.next_out = reinterpret_cast<Bytef*>(buf);
+    z.avail_out = sizeof buf;
+    rc = inflate(&z, Z_NO_FLUSH);
+    text.append(buf, sizeof buf - z.avail_out);
+    if (rc == Z_OK || rc == Z_STREAM_END) continue;
+    const std::size_t at = bytes.size() - z.avail_in;
+    const std::string why = z.msg ? z.msg : "zlib error " + std::to_string(rc);
+    inflateEnd(&z);
+    if (rc == Z_BUF_ERROR) {
+      throw RecordingError(source, 0, "",
+                           "truncated gzip stream: it ends after " + std::to_string(at) +
+                               " compressed bytes (" + std::to_string(text.size()) +
+                               " bytes decompressed) before its end-of-stream marker");
+    }
+    throw RecordingError(
+        source, 0, "",
+        "corrupt gzip data at compressed byte " + std::to_string(at) + " (" + why + ")");
+  }
+  inflateEnd(&z);
+  return text;
+}
 
 RecordingError::RecordingError(std::string source, std::size_t line, std::string column,
                                const std::string& msg)
@@ -193,118 +213,141 @@ void Recording::find_gaps(const std::vector<std::size_t>& row_lines) {
   }
 }
 
+namespace detail {
+
+// parse_recording's steps: the version line, metadata lines up to the
+// header, the header, then one data row per line.
+class RecordingParser {
+ public:
+  explicit RecordingParser(const std::string& source) : source_(source) {}
+
+  void line(std::string_view line, std::size_t line_no) {
+    line_no_ = line_no;
+    if (line_no == 1) return version_line(line);
+    if (!have_header_ && !line.empty() && line.front() == '#') return metadata_line(line);
+    if (trim(line).empty()) return;
+    if (!have_header_) return header_line(line);
+    data_row(line);
+  }
+
+  Recording finish() {
+    if (!have_header_) throw error("", "no header line found");
+    if (rec_.rows() == 0) throw error("", "no data rows");
+    rec_.find_gaps(row_lines_);
+    return std::move(rec_);
+  }
+
+ private:
+  RecordingError error(const std::string& column, const std::string& msg) const {
+    return RecordingError(source_, line_no_, column, msg);
+  }
+
+  void version_line(std::string_view line) {
+    if (trim(line) != "# hrg-recording v1") {
+      throw error("",
+                  "first line must be '# hrg-recording v1' (not an hrg recording, "
+                  "or another version)");
+    }
+  }
+
+  // '# key = value'; a comment line without '=' is free text.
+  void metadata_line(std::string_view line) {
+    const std::string_view body = trim(line.substr(1));
+    const std::size_t eq = body.find('=');
+    if (eq == std::string_view::npos) return;
+    const std::string key(trim(body.substr(0, eq)));
+    const std::string value(trim(body.substr(eq + 1)));
+    if (key.empty()) throw error("", "metadata line without a key");
+    double v = 0.0;
+    bool not_finite = false;
+    const auto& req = kRequiredMetadata;
+    if (std::find(std::begin(req), std::end(req), key) != std::end(req) &&
+        !parse_number(value, v, not_finite)) {
+      throw error("", "metadata '" + key + "' is not a finite number: '" + value + "'");
+    }
+    rec_.set_metadata(key, value);
+  }
+
+  void header_line(std::string_view line) {
+    for (auto cell : split_commas(line)) {
+      const std::string name(trim(cell));
+      if (name.empty()) throw error("", "empty column name in header");
+      if (rec_.has_column(name)) throw error(name, "column named twice in the header");
+      rec_.columns_.push_back(name);
+    }
+    for (auto req : kRequiredColumns) {
+      if (!rec_.has_column(req))
+        throw error(std::string(req), "required column missing from the header");
+    }
+    for (auto req : kRequiredMetadata) {
+      if (rec_.metadata_value(req).empty())
+        throw error("", "required metadata '" + std::string(req) + "' missing before the header");
+    }
+    const auto& cols = rec_.columns_;
+    rec_.data_.resize(cols.size());
+    t_col_ = static_cast<std::size_t>(std::find(cols.begin(), cols.end(), "t_s") - cols.begin());
+    exc_col_ = static_cast<std::size_t>(std::find(cols.begin(), cols.end(), "exc") - cols.begin());
+    row_.resize(cols.size());
+    have_header_ = true;
+  }
+
+  void data_row(std::string_view line) {
+    const auto cells = split_commas(line);
+    if (cells.size() != rec_.columns_.size()) {
+      throw error("", "row has " + std::to_string(cells.size()) + " cells, header has " +
+                          std::to_string(rec_.columns_.size()) + " columns");
+    }
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      bool not_finite = false;
+      if (!parse_number(cells[c], row_[c], not_finite)) {
+        throw error(rec_.columns_[c], "column " + std::to_string(c + 1) + ": '" +
+                                          std::string(trim(cells[c])) + "' is " +
+                                          (not_finite ? "NaN or infinite" : "not a number"));
+      }
+    }
+    if (row_[exc_col_] != 0.0 && row_[exc_col_] != 1.0)
+      throw error("exc", "must be 0 or 1, got '" + std::string(trim(cells[exc_col_])) + "'");
+    const auto& t = rec_.data_[t_col_];
+    if (!t.empty() && !(row_[t_col_] > t.back())) {
+      throw error("t_s", "time does not increase (" + std::string(trim(cells[t_col_])) +
+                             " after line " + std::to_string(row_lines_.back()) + ")");
+    }
+    for (std::size_t c = 0; c < row_.size(); ++c)
+      rec_.data_[c].push_back(row_[c]);
+    row_lines_.push_back(line_no_);
+  }
+
+  const std::string& source_;
+  Recording rec_;
+  std::size_t line_no_ = 0;
+  bool have_header_ = false;
+  std::size_t t_col_ = 0;
+  std::size_t exc_col_ = 0;
+  std::vector<double> row_;
+  std::vector<std::size_t> row_lines_;
+};
+
+}  // namespace detail
+
 Recording parse_recording(std::string_view text, const std::string& source) {
-  Recording rec;
+  detail::RecordingParser parser(source);
   std::size_t pos = 0;
   std::size_t line_no = 0;
-  bool have_header = false;
-  std::vector<std::size_t> row_lines;
-  std::size_t t_col = 0;
-  std::size_t exc_col = 0;
-  std::vector<double> row;
   while (pos < text.size()) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
     std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
-    ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line_no == 1) {
-      if (trim(line) != "# hrg-recording v1") {
-        throw RecordingError(source, 1, "",
-                             "first line must be '# hrg-recording v1' (not an hrg recording, "
-                             "or another version)");
-      }
-      continue;
-    }
-    if (!have_header) {
-      if (!line.empty() && line.front() == '#') {
-        const std::string_view body = trim(line.substr(1));
-        const std::size_t eq = body.find('=');
-        if (eq == std::string_view::npos) continue;  // free comment line
-        const std::string key(trim(body.substr(0, eq)));
-        const std::string value(trim(body.substr(eq + 1)));
-        if (key.empty()) throw RecordingError(source, line_no, "", "metadata line without a key");
-        for (auto req : kRequiredMetadata) {
-          double v = 0.0;
-          bool nf = false;
-          if (key == req && !parse_number(value, v, nf)) {
-            throw RecordingError(source, line_no, "",
-                                 "metadata '" + key + "' is not a finite number: '" + value + "'");
-          }
-        }
-        rec.set_metadata(key, value);
-        continue;
-      }
-      if (trim(line).empty()) continue;
-      // Header line.
-      for (auto cell : split_commas(line)) {
-        const std::string name(trim(cell));
-        if (name.empty()) throw RecordingError(source, line_no, "", "empty column name in header");
-        if (rec.has_column(name)) {
-          throw RecordingError(source, line_no, name, "column named twice in the header");
-        }
-        rec.columns_.push_back(name);
-      }
-      for (auto req : kRequiredColumns) {
-        if (!rec.has_column(req)) {
-          throw RecordingError(source, line_no, std::string(req),
-                               "required column missing from the header");
-        }
-      }
-      for (auto req : kRequiredMetadata) {
-        if (rec.metadata_value(req).empty()) {
-          throw RecordingError(
-              source, line_no, "",
-              "required metadata '" + std::string(req) + "' missing before the header");
-        }
-      }
-      rec.data_.resize(rec.columns_.size());
-      const auto& cols = rec.columns_;
-      t_col = static_cast<std::size_t>(std::find(cols.begin(), cols.end(), "t_s") - cols.begin());
-      exc_col = static_cast<std::size_t>(std::find(cols.begin(), cols.end(), "exc") - cols.begin());
-      row.resize(cols.size());
-      have_header = true;
-      continue;
-    }
-    if (trim(line).empty()) continue;
-    const auto cells = split_commas(line);
-    if (cells.size() != rec.columns_.size()) {
-      throw RecordingError(source, line_no, "",
-                           "row has " + std::to_string(cells.size()) + " cells, header has " +
-                               std::to_string(rec.columns_.size()) + " columns");
-    }
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      bool not_finite = false;
-      if (!parse_number(cells[c], row[c], not_finite)) {
-        throw RecordingError(source, line_no, rec.columns_[c],
-                             "column " + std::to_string(c + 1) + ": '" +
-                                 std::string(trim(cells[c])) + "' is " +
-                                 (not_finite ? "NaN or infinite" : "not a number"));
-      }
-    }
-    if (row[exc_col] != 0.0 && row[exc_col] != 1.0) {
-      throw RecordingError(source, line_no, "exc",
-                           "must be 0 or 1, got '" + std::string(trim(cells[exc_col])) + "'");
-    }
-    if (!rec.data_[t_col].empty() && !(row[t_col] > rec.data_[t_col].back())) {
-      throw RecordingError(source, line_no, "t_s",
-                           "time does not increase (" + std::string(trim(cells[t_col])) +
-                               " after line " + std::to_string(row_lines.back()) + ")");
-    }
-    for (std::size_t c = 0; c < row.size(); ++c)
-      rec.data_[c].push_back(row[c]);
-    row_lines.push_back(line_no);
+    parser.line(line, ++line_no);
   }
-  if (!have_header) throw RecordingError(source, line_no, "", "no header line found");
-  if (rec.rows() == 0) throw RecordingError(source, line_no, "", "no data rows");
-  rec.find_gaps(row_lines);
-  return rec;
+  return parser.finish();
 }
 
 Recording read_recording(const std::filesystem::path& path) {
-  const std::string text = read_file_bytes(path);
-  return parse_recording(text, path.string());
+  const std::string bytes = read_file_bytes(path);
+  if (!is_gzip(bytes)) return parse_recording(bytes, path.string());
+  return parse_recording(gunzip(bytes, path.string()), path.string());
 }
 
 void write_recording(const std::filesystem::path& path, const Recording& rec) {

@@ -13,6 +13,10 @@
 // (docs/recording-format.md). Host-only: uses the heap, exceptions and zlib.
 namespace hrg::recording {
 
+namespace detail {
+class RecordingParser;
+}
+
 // A malformed recording. `line` is 1-based (0 when the problem is not on one
 // line, e.g. a missing metadata key); `column` is the column name when the
 // problem is in one cell or column, empty otherwise. what() says all of it.
@@ -80,7 +84,7 @@ class Recording {
   void find_gaps(const std::vector<std::size_t>& row_lines = {});
 
  private:
-  friend Recording parse_recording(std::string_view, const std::string&);
+  friend class detail::RecordingParser;
   std::vector<std::string> columns_;
   std::vector<std::vector<double>> data_;
   std::vector<std::pair<std::string, std::string>> metadata_;
@@ -96,8 +100,17 @@ std::string format_number(double v);
 // Throws RecordingError for anything malformed (see the format doc).
 Recording parse_recording(std::string_view text, const std::string& source);
 
+// True when `bytes` start with the gzip magic (1f 8b).
+bool is_gzip(std::string_view bytes);
+
+// Decompresses gzip data held in memory (one member or several in a row).
+// Throws RecordingError (line 0) naming `source` for a truncated stream (and
+// how far it got) or corrupt data (and at which compressed byte).
+std::string gunzip(std::string_view bytes, const std::string& source);
+
 // Reads a .csv or .csv.gz file (gzip detected from the magic bytes).
-// Throws RecordingError (with line 0) when the file cannot be read.
+// Throws RecordingError (with line 0) when the file cannot be read or its
+// gzip stream is truncated or corrupt.
 Recording read_recording(const std::filesystem::path& path);
 
 // Writes the whole recording; gzip-compressed when the name ends in ".gz".

@@ -7,11 +7,27 @@
 
 namespace hrg::simtools {
 
-// A job from a TOML scenario (sim_target/scenarios/*.toml). A scenario with a
-// constant rate gets the default job's rate-table schedule (sweep, then the
-// parked-angle bias test) on top of that rate; a scenario with its own rate
-// profile runs as given for `duration_s` (default 120 s) without parks.
-// Throws sim::ScenarioError (naming the key) or std::runtime_error.
-JobConfig job_from_scenario(const std::string& path, double duration_s, int bias_angles);
+// The run options of `hrg sim` that shape the schedule.
+struct ScheduleOptions {
+  double duration_s = 0.0;  // 0: the schedule's own length
+  int bias_angles = 0;      // parked angles of the bias test; 0: not given (16)
+  bool static_base = false;
+};
+
+// The job `hrg sim` runs: the default job, or the scenario file's resonator,
+// converters, rate and effects under the schedule the options ask for.
+//  - A scenario with a constant rate gets the default rate-table schedule
+//    (sweep, then the parked-angle bias test) on top of that rate, or with
+//    `static_base` no table at all: the firmware turns the pattern itself.
+//  - A scenario with its own rate profile runs as given for `duration_s`
+//    (default 120 s), without parks.
+// Combinations with no meaning are refused, never dropped: a static base with
+// a rate profile or with parked angles, parked angles with a rate profile.
+// Throws std::invalid_argument naming the options, sim::ScenarioError naming
+// the key, or std::runtime_error.
+JobConfig make_job(const std::string& scenario_path, const ScheduleOptions& o);
+
+// A job from a TOML scenario (sim_target/scenarios/*.toml), as make_job.
+JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o);
 
 }  // namespace hrg::simtools
