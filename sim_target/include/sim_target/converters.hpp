@@ -11,6 +11,7 @@
 // low bits) -> v = code / 2^(bits-1) * FS. A code at either rail is reported
 // as saturated: the firmware asked for the converter's limit.
 
+#include <cmath>
 #include <cstdint>
 
 #include "hal/converters.hpp"
@@ -21,7 +22,22 @@ namespace hrg::sim {
 class AdcQuantizer {
  public:
   explicit AdcQuantizer(const AdcConfig& c = {});
-  hal::sample_q31 convert(double v, bool& clipped) const;
+  // Inline: the simulated board calls it twice per sample.
+  hal::sample_q31 convert(double v, bool& clipped) const {
+    const double scaled = std::nearbyint(v / lsb_v_);
+    int64_t code = 0;
+    clipped = false;
+    if (!(scaled < static_cast<double>(code_max_))) {
+      code = code_max_;
+      clipped = true;
+    } else if (!(scaled > static_cast<double>(-code_max_ - 1))) {
+      code = -code_max_ - 1;
+      clipped = true;
+    } else {
+      code = static_cast<int64_t>(scaled);
+    }
+    return static_cast<hal::sample_q31>(code * (int64_t{1} << (32 - bits_)));
+  }
   double lsb_v() const { return lsb_v_; }
   // Volts of a Q1.31 word (for tests and the back door).
   double to_volts(hal::sample_q31 word) const;
@@ -36,7 +52,13 @@ class AdcQuantizer {
 class DacQuantizer {
  public:
   explicit DacQuantizer(const DacConfig& c = {});
-  double convert(hal::sample_q31 word, bool& saturated) const;
+  double convert(hal::sample_q31 word, bool& saturated) const {
+    const int64_t code = static_cast<int64_t>(word) >> (32 - bits_);
+    saturated = code >= code_max_ || code <= -code_max_ - 1;
+    // code / 2^(bits-1) is exact, so one product by volts_per_code_ rounds as
+    // code / 2^(bits-1) * FS did.
+    return static_cast<double>(code) * volts_per_code_;
+  }
   // The Q1.31 word whose output is closest to v (tests, envelope helpers).
   hal::sample_q31 word_for(double v) const;
 
@@ -44,6 +66,7 @@ class DacQuantizer {
   uint32_t bits_;
   double full_scale_v_;
   int64_t code_max_;
+  double volts_per_code_;  // FS / 2^(bits-1)
 };
 
 }  // namespace hrg::sim
