@@ -161,20 +161,6 @@ std::size_t Profile::segment_of(double t_s) const {
   return static_cast<std::size_t>(it - points_.begin());
 }
 
-double Profile::value_in_segment(double t_s, std::size_t segment) const {
-  if (kind_ == Kind::steps) {
-    if (segment == 0) return offset_ + points_.front().value;
-    return offset_ + points_[segment - 1].value;
-  }
-  // ramps
-  if (t_s <= points_.front().t_s) return offset_ + points_.front().value;
-  if (t_s >= points_.back().t_s) return offset_ + points_.back().value;
-  const ProfilePoint& b = points_[segment];
-  const ProfilePoint& a = points_[segment - 1];
-  const double u = (t_s - a.t_s) / (b.t_s - a.t_s);
-  return offset_ + a.value + u * (b.value - a.value);
-}
-
 double Profile::value(double t_s) const {
   switch (kind_) {
     case Kind::constant: return offset_;
@@ -186,10 +172,13 @@ double Profile::value(double t_s) const {
   return offset_;
 }
 
-double ProfileCursor::value(double t_s, bool next_step, double step_s) {
+double ProfileCursor::value_searched(double t_s, bool next_step, double step_s) {
   const Profile& p = *p_;
   switch (p.kind_) {
-    case Profile::Kind::constant: return p.offset_;
+    case Profile::Kind::constant:
+      lo_s_ = -std::numeric_limits<double>::infinity();
+      hi_s_ = std::numeric_limits<double>::infinity();
+      return p.offset_;
     case Profile::Kind::sine: return sine_value(t_s, next_step, step_s);
     case Profile::Kind::steps:
     case Profile::Kind::ramps:

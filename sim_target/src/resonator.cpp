@@ -46,6 +46,7 @@ Resonator::Resonator(const ResonatorParams& params, const ElectrodeParams& elect
     : params_(params),
       electrodes_(electrodes),
       effects_(effects),
+      pickoff_effects_(any_pickoff_effect(effects)),
       temp_(Profile::constant(params.temp_ref_c)),
       f_ref_hz_(params.f_hz) {}
 
@@ -59,6 +60,7 @@ void Resonator::set_electrodes(const ElectrodeParams& e) {
 }
 void Resonator::set_effects(const Effects& fx) {
   effects_ = fx;
+  pickoff_effects_ = any_pickoff_effect(fx);
   expanded_ = false;
 }
 void Resonator::set_rate_profile(Profile rate_rad_s) {
@@ -173,15 +175,16 @@ double Resonator::pump_delayed(double delay_samples) const {
 }
 
 double Resonator::push_pump(double pump_v) {
-  hist_pos_ = (hist_pos_ + 1) % kHistory;
-  const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_ + kHistory) % kHistory];
+  constexpr int kMask = kHistory - 1;  // kHistory is a power of two
+  hist_pos_ = (hist_pos_ + 1) & kMask;
+  const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_) & kMask];
   pump_hist_[hist_pos_] = pump_v;
   pump_sq_hist_[hist_pos_] = pump_v * pump_v;
   if (hist_pos_ == 0 || !pump_sum_valid_) {
     // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
     pump_sq_sum_ = 0.0;
     for (int i = 0; i < avg_len_; ++i)
-      pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i + kHistory) % kHistory];
+      pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
     pump_sum_valid_ = true;
   } else {
     pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
@@ -253,7 +256,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   ++steps_;
 }
 
-PickoffOutput Resonator::measured() const {
+PickoffOutput Resonator::measured_with_effects() const {
   double x = u_(0);
   double y = u_(1);
   double vy = u_(3);

@@ -24,7 +24,7 @@ class AdcQuantizer {
   explicit AdcQuantizer(const AdcConfig& c = {});
   // Inline: the simulated board calls it twice per sample.
   hal::sample_q31 convert(double v, bool& clipped) const {
-    const double scaled = std::nearbyint(v / lsb_v_);
+    const double scaled = round_to_even(v / lsb_v_);
     int64_t code = 0;
     clipped = false;
     if (!(scaled < static_cast<double>(code_max_))) {
@@ -39,6 +39,13 @@ class AdcQuantizer {
     return static_cast<hal::sample_q31>(code * (int64_t{1} << (32 - bits_)));
   }
   double lsb_v() const { return lsb_v_; }
+  // std::nearbyint in the default rounding mode without the library call:
+  // adding and removing 1.5 2^52 rounds to the nearest integer (ties to even)
+  // for |x| < 2^51; beyond that every code saturates anyway.
+  static double round_to_even(double x) {
+    constexpr double kMagic = 0x1.8p52;
+    return std::fabs(x) < 0x1p51 ? (x + kMagic) - kMagic : x;
+  }
   // Volts of a Q1.31 word (for tests and the back door).
   double to_volts(hal::sample_q31 word) const;
 

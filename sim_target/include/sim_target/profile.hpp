@@ -66,7 +66,8 @@ class Profile {
  private:
   friend class ProfileCursor;
   // steps/ramps: index of the first point after t_s (0 before the first
-  // point, points_.size() from the last one on), and the value there.
+  // point, points_.size() from the last one on), and the value there
+  // (constant: the value).
   std::size_t segment_of(double t_s) const;
   double value_in_segment(double t_s, std::size_t segment) const;
 
@@ -77,6 +78,24 @@ class Profile {
   double phase_rad_ = 0.0;
   std::vector<ProfilePoint> points_;
 };
+
+inline double Profile::value_in_segment(double t_s, std::size_t segment) const {
+  switch (kind_) {
+    case Kind::constant: return offset_;
+    case Kind::steps:
+      return offset_ + (segment == 0 ? points_.front().value : points_[segment - 1].value);
+    case Kind::ramps: {
+      if (t_s <= points_.front().t_s) return offset_ + points_.front().value;
+      if (t_s >= points_.back().t_s) return offset_ + points_.back().value;
+      const ProfilePoint& b = points_[segment];
+      const ProfilePoint& a = points_[segment - 1];
+      const double u = (t_s - a.t_s) / (b.t_s - a.t_s);
+      return offset_ + a.value + u * (b.value - a.value);
+    }
+    case Kind::sine: break;  // not by segment
+  }
+  return offset_;
+}
 
 // A profile sampled at consecutive instants t_k = t_0 + k h (the full-rate
 // integrator's step midpoints) without a search or a libm call per sample:
@@ -111,9 +130,13 @@ class ProfileCursor {
 
   // Value at t_s. `next_step` promises t_s = previous t_s + step_s (with the
   // previous call's step_s), which lets a sine rotate instead of calling sin.
-  double value(double t_s, bool next_step, double step_s);
+  double value(double t_s, bool next_step, double step_s) {
+    if (t_s >= lo_s_ && t_s < hi_s_) return p_->value_in_segment(t_s, segment_);
+    return value_searched(t_s, next_step, step_s);
+  }
 
  private:
+  double value_searched(double t_s, bool next_step, double step_s);
   double sine_value(double t_s, bool next_step, double step_s);
 
   const Profile* p_ = nullptr;

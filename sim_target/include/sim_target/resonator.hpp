@@ -98,7 +98,10 @@ class Resonator {
   // Analytic envelopes X = x - i x'/w, Y = y - i y'/w (x = Re X at this instant);
   // wave_state() of them gives E, Q, R, S and theta_A of the true wave.
   void envelopes(std::complex<double>& x_env, std::complex<double>& y_env) const;
-  PickoffOutput measured() const;
+  PickoffOutput measured() const {
+    if (!pickoff_effects_) return {u_(0), u_(1)};  // inline: called once per sample
+    return measured_with_effects();
+  }
   double last_pump_v() const { return pump_hist_[hist_pos_]; }
 
  private:
@@ -109,11 +112,17 @@ class Resonator {
 
   void expand(double rate_rad_s, double omega_rad_s, double dt_s);
   double pump_delayed(double delay_samples) const;
-  double push_pump(double pump_v);  // records the held pump voltage, returns <V^2>
+  double push_pump(double pump_v);
+  PickoffOutput measured_with_effects() const;
+  static bool any_pickoff_effect(const Effects& fx) {
+    return fx.pickoff_misalignment.enabled || fx.pickoff_gain_mismatch.enabled ||
+           fx.pickoff_phase_mismatch.enabled || fx.drive_feedthrough.enabled;
+  }  // records the held pump voltage, returns <V^2>
 
   ResonatorParams params_;
   ElectrodeParams electrodes_;
   Effects effects_;
+  bool pickoff_effects_ = false;  // any effect on the measured side
   Profile rate_;
   Profile temp_;
   ProfileCursor rate_at_;  // rate_ and temp_ at step midpoints, sample by sample
@@ -142,6 +151,7 @@ class Resonator {
 
   // Pump history for <V^2> and the feedthrough phase.
   static constexpr int kHistory = 256;
+  static_assert((kHistory & (kHistory - 1)) == 0, "the ring index is masked");
   std::array<double, kHistory> pump_hist_{};
   std::array<double, kHistory> pump_sq_hist_{};
   int hist_pos_ = 0;
