@@ -388,15 +388,18 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   fw::DspChainPort chain(job.chain);
   if (const char* err = chain.error())
     throw std::invalid_argument(std::string("signal chain configuration: ") + err);
-  sim::SimTarget& target = sim::target();
+  // A simulated target of its own: runs in parallel threads share nothing.
+  const auto own_target = std::make_unique<sim::SimTarget>();
+  sim::SimTarget& target = *own_target;
   target.configure(job.sim);
+  target.set_profiling(opt.profile);
   fw::EstimatorPort ident(job.estimator);
   // Lockstep: the board's simulated clock paces (it returns at once) and a
   // host clock times the tasks. Real time: CLOCK_MONOTONIC does both, with
   // the simulated converters behind it.
   HostClock host_timer;
   hal::linux_board::LinuxClock rt_clock;
-  hal::Board& sim_board = hal::board();  // the simulated target, chosen at link time
+  hal::Board& sim_board = target.board();
   hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
                       sim_board.fault_input, sim_board.can, rt_clock};
   r.real_time = opt.real_time;
@@ -567,6 +570,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   }
   r.coverage = ident.health().coverage;
   summarise_executive(r, *gyro);
+  r.sim_stages = target.stage_times();
   if (log) log->flush();
   analyse(r, job);
   return r;
