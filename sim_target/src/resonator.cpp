@@ -155,7 +155,8 @@ void Resonator::expand(double rate_rad_s, double omega_rad_s, double dt_s) {
   psi_iso_ = raw(first_order(a, lower_left(-Mat2::Identity() / w), dt_s));
   psi_damp_ = raw(first_order(a, lower_right(-damp), dt_s));
 
-  stacked_ << phi_, psi_rate1_, psi_rate2_, psi_gap_;
+  rate_gap_.bottomRows<4>() = psi_gap_;
+  rate_prop_valid_ = false;
   spring_k_ = effects_.electrostatic_spring.enabled
                   ? -8.0 * kPi * params_.omega_rad_s() * effects_.electrostatic_spring.hz_per_v2
                   : 0.0;
@@ -226,15 +227,21 @@ void Resonator::step(const Drive& drive, double dt_s) {
   const double energy =
       needs_energy ? u_(0) * u_(0) + u_(1) * u_(1) + (u_(2) * u_(2) + u_(3) * u_(3)) / (w * w)
                    : 0.0;
-  // [Phi u; dPhi/dOmega u; second-order rate term u; pump sensitivity u] in one product.
-  const Eigen::Matrix<double, 16, 1> terms = stacked_ * u_;
-  Vec4 next = terms.segment<4>(0);
-  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
+  // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only
+  // when the rate changes (every step of a ramp, once per hold); then
+  // [that propagator u; pump sensitivity u] in one 8x4 product.
   const double d_rate = rate - rate_c_;
-  next += d_rate * terms.segment<4>(4) + (d_rate * d_rate) * terms.segment<4>(8);
+  if (!rate_prop_valid_ || d_rate != rate_prop_d_) {
+    rate_gap_.topRows<4>() = phi_ + d_rate * psi_rate1_ + (d_rate * d_rate) * psi_rate2_;
+    rate_prop_d_ = d_rate;
+    rate_prop_valid_ = true;
+  }
+  const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u_;
+  Vec4 next = terms.head<4>();
+  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
   const double v2 = drive.pump_v * drive.pump_v;
   const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k_ * v2_dc;
-  next += c_gap * terms.segment<4>(12);
+  next += c_gap * terms.tail<4>();
 
   double c_iso = w * w - omega_c_ * omega_c_;
   if (effects_.duffing_stiffness.enabled) {

@@ -24,8 +24,9 @@
 // nonlinear terms (evaluated at the step's midpoint), and Omega - Omega_c to
 // second order. The expansion point moves when Omega drifts by more than
 // 0.05 rad/s or the frequency by more than 1e-3 rad/s, which keeps the
-// neglected terms below 1e-15 per step. Cost per sample: one 16x4
-// matrix-vector product (Phi and the rate and pump sensitivities stacked), the
+// neglected terms below 1e-15 per step. Cost per sample: one 8x4
+// matrix-vector product (the propagator at the present rate, formed only when
+// the rate changes, stacked with the pump sensitivity), the
 // rate and temperature from profile cursors (no search, no clock), and a
 // running <V^2> sum re-added exactly every kHistory steps (its rounding drift
 // stays below 2 kHistory eps max(V^2) = 1.2e-11 V^2 at 10 V of pump).
@@ -108,7 +109,6 @@ class Resonator {
   using Mat4 = Eigen::Matrix<double, 4, 4>;
   using Vec4 = Eigen::Matrix<double, 4, 1>;
   using Mat42 = Eigen::Matrix<double, 4, 2>;
-  using Mat164 = Eigen::Matrix<double, 16, 4>;
 
   void expand(double rate_rad_s, double omega_rad_s, double dt_s);
   double pump_delayed(double delay_samples) const;
@@ -146,8 +146,11 @@ class Resonator {
   Mat4 psi_gap_;                // sensitivity to a stiffness -c G (pump, spring): force +c G u
   Mat4 psi_iso_;                // sensitivity to a stiffness +c I (frequency change, Duffing)
   Mat4 psi_damp_;               // sensitivity to scaling the damping matrix by (1 + c)
-  Mat164 stacked_;              // [phi_; psi_rate1_; psi_rate2_; psi_gap_]: one product per step
-  double spring_k_ = 0.0;       // DC-pump stiffness per V^2 of <V^2> (0 when off)
+  // [Phi + dO Psi1 + dO^2 Psi2; psi_gap_] with dO = rate_prop_d_: one product per step.
+  Eigen::Matrix<double, 8, 4> rate_gap_;
+  double rate_prop_d_ = 0.0;
+  bool rate_prop_valid_ = false;
+  double spring_k_ = 0.0;  // DC-pump stiffness per V^2 of <V^2> (0 when off)
 
   // Pump history for <V^2> and the feedthrough phase.
   static constexpr int kHistory = 256;
