@@ -20,22 +20,6 @@ AdcQuantizer::AdcQuantizer(const AdcConfig& c)
       lsb_v_(c.full_scale_v / std::ldexp(1.0, static_cast<int>(c.bits) - 1)),
       code_max_((int64_t{1} << (c.bits - 1)) - 1) {}
 
-hal::q31_t AdcQuantizer::convert(double v, bool& clipped) const {
-  const double scaled = std::nearbyint(v / lsb_v_);
-  int64_t code = 0;
-  clipped = false;
-  if (!(scaled < static_cast<double>(code_max_))) {
-    code = code_max_;
-    clipped = true;
-  } else if (!(scaled > static_cast<double>(-code_max_ - 1))) {
-    code = -code_max_ - 1;
-    clipped = true;
-  } else {
-    code = static_cast<int64_t>(scaled);
-  }
-  return static_cast<hal::q31_t>(code * (int64_t{1} << (32 - bits_)));
-}
-
 double AdcQuantizer::to_volts(hal::q31_t word) const {
   return static_cast<double>(word) * 0x1.0p-31 * full_scale_v_;
 }
@@ -43,13 +27,8 @@ double AdcQuantizer::to_volts(hal::q31_t word) const {
 DacQuantizer::DacQuantizer(const DacConfig& c)
     : bits_(checked_bits(c.bits)),
       full_scale_v_(c.full_scale_v),
-      code_max_((int64_t{1} << (c.bits - 1)) - 1) {}
-
-double DacQuantizer::convert(hal::q31_t word, bool& saturated) const {
-  const int64_t code = static_cast<int64_t>(word) >> (32 - bits_);
-  saturated = code >= code_max_ || code <= -code_max_ - 1;
-  return static_cast<double>(code) / static_cast<double>(code_max_ + 1) * full_scale_v_;
-}
+      code_max_((int64_t{1} << (c.bits - 1)) - 1),
+      volts_per_code_(c.full_scale_v / static_cast<double>(code_max_ + 1)) {}
 
 hal::q31_t DacQuantizer::word_for(double v) const {
   const double code =

@@ -155,29 +155,66 @@ bool Profile::varies_between(double t0_s, double t1_s) const {
   return true;
 }
 
+std::size_t Profile::segment_of(double t_s) const {
+  const auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
+                                   [](double t, const ProfilePoint& p) { return t < p.t_s; });
+  return static_cast<std::size_t>(it - points_.begin());
+}
+
 double Profile::value(double t_s) const {
   switch (kind_) {
     case Kind::constant: return offset_;
     case Kind::sine:
       return offset_ + amplitude_ * std::sin(2.0 * std::numbers::pi * freq_hz_ * t_s + phase_rad_);
-    case Kind::steps: {
-      auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
-                                 [](double t, const ProfilePoint& p) { return t < p.t_s; });
-      if (it == points_.begin()) return offset_ + points_.front().value;
-      return offset_ + std::prev(it)->value;
-    }
-    case Kind::ramps: {
-      if (t_s <= points_.front().t_s) return offset_ + points_.front().value;
-      if (t_s >= points_.back().t_s) return offset_ + points_.back().value;
-      auto it = std::upper_bound(points_.begin(), points_.end(), t_s,
-                                 [](double t, const ProfilePoint& p) { return t < p.t_s; });
-      const ProfilePoint& b = *it;
-      const ProfilePoint& a = *std::prev(it);
-      const double u = (t_s - a.t_s) / (b.t_s - a.t_s);
-      return offset_ + a.value + u * (b.value - a.value);
-    }
+    case Kind::steps:
+    case Kind::ramps: return value_in_segment(t_s, segment_of(t_s));
   }
   return offset_;
+}
+
+double ProfileCursor::value_searched(double t_s, bool next_step, double step_s) {
+  const Profile& p = *p_;
+  switch (p.kind_) {
+    case Profile::Kind::constant:
+      lo_s_ = -std::numeric_limits<double>::infinity();
+      hi_s_ = std::numeric_limits<double>::infinity();
+      return p.offset_;
+    case Profile::Kind::sine: return sine_value(t_s, next_step, step_s);
+    case Profile::Kind::steps:
+    case Profile::Kind::ramps:
+      if (!(t_s >= lo_s_ && t_s < hi_s_)) {
+        const auto& pts = p.points_;
+        segment_ = p.segment_of(t_s);
+        lo_s_ = segment_ == 0 ? -std::numeric_limits<double>::infinity() : pts[segment_ - 1].t_s;
+        hi_s_ =
+            segment_ == pts.size() ? std::numeric_limits<double>::infinity() : pts[segment_].t_s;
+      }
+      return p.value_in_segment(t_s, segment_);
+  }
+  return p.offset_;
+}
+
+double ProfileCursor::sine_value(double t_s, bool next_step, double step_s) {
+  const Profile& p = *p_;
+  const double w = 2.0 * std::numbers::pi * p.freq_hz_;
+  if (anchored_ && next_step && step_s == step_s_ && rotations_ < kReanchorSteps) {
+    const double s = sin_ * rot_cos_ + cos_ * rot_sin_;
+    cos_ = cos_ * rot_cos_ - sin_ * rot_sin_;
+    sin_ = s;
+    ++rotations_;
+  } else {
+    const double phase = w * t_s + p.phase_rad_;
+    sin_ = std::sin(phase);
+    cos_ = std::cos(phase);
+    if (!anchored_ || step_s != step_s_) {
+      step_s_ = step_s;
+      rot_sin_ = std::sin(w * step_s);
+      rot_cos_ = std::cos(w * step_s);
+    }
+    rotations_ = 0;
+    anchored_ = true;
+  }
+  return p.offset_ + p.amplitude_ * sin_;
 }
 
 }  // namespace hrg::sim

@@ -46,6 +46,7 @@ Resonator::Resonator(const ResonatorParams& params, const ElectrodeParams& elect
     : params_(params),
       electrodes_(electrodes),
       effects_(effects),
+      pickoff_effects_(any_pickoff_effect(effects)),
       temp_(Profile::constant(params.temp_ref_c)),
       f_ref_hz_(params.f_hz) {}
 
@@ -59,10 +60,17 @@ void Resonator::set_electrodes(const ElectrodeParams& e) {
 }
 void Resonator::set_effects(const Effects& fx) {
   effects_ = fx;
+  pickoff_effects_ = any_pickoff_effect(fx);
   expanded_ = false;
 }
-void Resonator::set_rate_profile(Profile rate_rad_s) { rate_ = std::move(rate_rad_s); }
-void Resonator::set_temperature_profile(Profile temp_c) { temp_ = std::move(temp_c); }
+void Resonator::set_rate_profile(Profile rate_rad_s) {
+  rate_ = std::move(rate_rad_s);
+  rate_at_.bind(&rate_);
+}
+void Resonator::set_temperature_profile(Profile temp_c) {
+  temp_ = std::move(temp_c);
+  temp_at_.bind(&temp_);
+}
 void Resonator::set_reference_hz(double f_hz) {
   f_ref_hz_ = f_hz;
   dt_last_ = -1.0;  // recompute the <V^2> window at the next step
@@ -147,6 +155,11 @@ void Resonator::expand(double rate_rad_s, double omega_rad_s, double dt_s) {
   psi_iso_ = raw(first_order(a, lower_left(-Mat2::Identity() / w), dt_s));
   psi_damp_ = raw(first_order(a, lower_right(-damp), dt_s));
 
+  rate_gap_.bottomRows<4>() = psi_gap_;
+  rate_prop_valid_ = false;
+  spring_k_ = effects_.electrostatic_spring.enabled
+                  ? -8.0 * kPi * params_.omega_rad_s() * effects_.electrostatic_spring.hz_per_v2
+                  : 0.0;
   rate_c_ = rate_rad_s;
   omega_c_ = omega_rad_s;
   dt_c_ = dt_s;
@@ -162,15 +175,37 @@ double Resonator::pump_delayed(double delay_samples) const {
   return (1.0 - frac) * at(whole) + frac * at(whole + 1);
 }
 
+double Resonator::push_pump(double pump_v) {
+  constexpr int kMask = kHistory - 1;  // kHistory is a power of two
+  hist_pos_ = (hist_pos_ + 1) & kMask;
+  const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_) & kMask];
+  pump_hist_[hist_pos_] = pump_v;
+  pump_sq_hist_[hist_pos_] = pump_v * pump_v;
+  if (hist_pos_ == 0 || !pump_sum_valid_) {
+    // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
+    pump_sq_sum_ = 0.0;
+    for (int i = 0; i < avg_len_; ++i)
+      pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
+    pump_sum_valid_ = true;
+  } else {
+    pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
+  }
+  return pump_sq_sum_ / avg_len_;
+}
+
 void Resonator::step(const Drive& drive, double dt_s) {
   if (dt_s != step_s_) {
     t0_s_ = time_s();
     steps_ = 0;
     step_s_ = dt_s;
   }
+  if (rate_at_.profile() != &rate_) rate_at_.bind(&rate_);  // after a copy or a move
+  if (temp_at_.profile() != &temp_) temp_at_.bind(&temp_);
+  const bool next_step = steps_ != 0 && steps_ == cursor_steps_ + 1;
+  cursor_steps_ = steps_;
   const double t_mid = time_s() + 0.5 * dt_s;
-  const double rate = rate_.value(t_mid);
-  const double temp_c = temp_.value(t_mid);
+  const double rate = rate_at_.value(t_mid, next_step, dt_s);
+  const double temp_c = temp_at_.value(t_mid, next_step, dt_s);
   const double w = detail::thermal_omega(params_, effects_, temp_c);
   if (!expanded_ || dt_s != dt_c_ || std::abs(rate - rate_c_) > kRateReexpandRadS ||
       std::abs(w - omega_c_) > kOmegaReexpandRadS) {
@@ -180,31 +215,33 @@ void Resonator::step(const Drive& drive, double dt_s) {
     dt_last_ = dt_s;
     avg_len_ = std::max(
         1, std::min(kHistory - 1, static_cast<int>(std::lround(1.0 / (f_ref_hz_ * dt_s)))));
+    pump_sum_valid_ = false;
   }
 
   // Pump history: <V^2> over one reference period (the DC part of V^2).
-  hist_pos_ = (hist_pos_ + 1) % kHistory;
-  pump_hist_[hist_pos_] = drive.pump_v;
-  pump_sq_hist_[hist_pos_] = drive.pump_v * drive.pump_v;
-  double v2_dc = 0.0;
-  for (int i = 0; i < avg_len_; ++i)
-    v2_dc += pump_sq_hist_[(hist_pos_ - i + kHistory) % kHistory];
-  v2_dc /= avg_len_;
+  const double v2_dc = push_pump(drive.pump_v);
 
-  const double energy = u_(0) * u_(0) + u_(1) * u_(1) + (u_(2) * u_(2) + u_(3) * u_(3)) / (w * w);
-  Vec4 next = phi_ * u_;
-  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
+  // E = x^2 + y^2 + (x'^2 + y'^2)/w^2, needed only by the amplitude-dependent effects.
+  const bool needs_energy =
+      effects_.duffing_stiffness.enabled || effects_.nonlinear_damping.enabled;
+  const double energy =
+      needs_energy ? u_(0) * u_(0) + u_(1) * u_(1) + (u_(2) * u_(2) + u_(3) * u_(3)) / (w * w)
+                   : 0.0;
+  // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only
+  // when the rate changes (every step of a ramp, once per hold); then
+  // [that propagator u; pump sensitivity u] in one 8x4 product.
   const double d_rate = rate - rate_c_;
-  if (d_rate != 0.0)
-    next.noalias() += psi_rate1_ * (d_rate * u_) + psi_rate2_ * (d_rate * d_rate * u_);
-
-  const double spring_k =
-      effects_.electrostatic_spring.enabled
-          ? -8.0 * kPi * params_.omega_rad_s() * effects_.electrostatic_spring.hz_per_v2
-          : 0.0;
+  if (!rate_prop_valid_ || d_rate != rate_prop_d_) {
+    rate_gap_.topRows<4>() = phi_ + d_rate * psi_rate1_ + (d_rate * d_rate) * psi_rate2_;
+    rate_prop_d_ = d_rate;
+    rate_prop_valid_ = true;
+  }
+  const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u_;
+  Vec4 next = terms.head<4>();
+  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
   const double v2 = drive.pump_v * drive.pump_v;
-  const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k * v2_dc;
-  if (c_gap != 0.0) next.noalias() += psi_gap_ * (c_gap * u_);
+  const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k_ * v2_dc;
+  next += c_gap * terms.tail<4>();
 
   double c_iso = w * w - omega_c_ * omega_c_;
   if (effects_.duffing_stiffness.enabled) {
@@ -226,8 +263,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   ++steps_;
 }
 
-PickoffOutput Resonator::measured() const {
-  const double w = omega_rad_s();
+PickoffOutput Resonator::measured_with_effects() const {
   double x = u_(0);
   double y = u_(1);
   double vy = u_(3);
@@ -243,7 +279,7 @@ PickoffOutput Resonator::measured() const {
   if (effects_.pickoff_phase_mismatch.enabled) {
     // Y e^{-i phi}: for a narrow-band signal at w, y(t - phi/w) = y cos phi - (y'/w) sin phi.
     const double phi = effects_.pickoff_phase_mismatch.phase_deg * kDegToRad;
-    y = y * std::cos(phi) - vy / w * std::sin(phi);
+    y = y * std::cos(phi) - vy / omega_rad_s() * std::sin(phi);
   }
   if (effects_.drive_feedthrough.enabled) {
     // c V e^{i psi}: Re(Vc e^{i psi} e^{iwt}) = cos psi V(t) - sin psi V(t - T/4).

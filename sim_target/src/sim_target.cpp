@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "sim_target/control.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -46,6 +48,7 @@ void SimTarget::configure(const SimConfig& c) {
   input_angle_rad_ = 0.0;
   last_pump_v_ = 0.0;
   counters_ = {};
+  stage_times_ = {};
 }
 
 void SimTarget::set_rate_profile(Profile rate_rad_s) {
@@ -122,7 +125,7 @@ Drive SimTarget::next_drive() {
   }
   if (!dac_latency_.empty()) {
     std::swap(frame, dac_latency_[latency_pos_]);
-    latency_pos_ = (latency_pos_ + 1) % dac_latency_.size();
+    if (++latency_pos_ == dac_latency_.size()) latency_pos_ = 0;
   }
   std::array<double, hal::kDacChannels> v{};
   for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
@@ -134,42 +137,101 @@ Drive SimTarget::next_drive() {
   return Drive{v[0], v[1], v[2]};
 }
 
-Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
-                                uint32_t& clipped) {
-  const uint32_t n = config_.adc.block_frames;
-  if (frames.size() != static_cast<std::size_t>(n) * hal::kAdcChannels) {
-    return Status::invalid_argument;
+namespace {
+
+// Host time of the block's stages, read only while profiling is on.
+class StageLaps {
+ public:
+  explicit StageLaps(SimStageTimes* times) : times_(times) {
+    if (times_) last_ = std::chrono::steady_clock::now();
   }
-  const double dt = 1.0 / config_.adc.sample_rate_hz;
-  const double t0 = time_s();
-  t_first_ns = sample_time_ns(sample_index_);
-  clipped = 0;
-  for (uint32_t k = 0; k < n; ++k) {
+  void lap(uint64_t SimStageTimes::*stage) {
+    if (!times_) return;
+    const auto now = std::chrono::steady_clock::now();
+    times_->*stage += static_cast<uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  SimStageTimes* times_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace
+
+void SimTarget::run_resonator(std::size_t n, double dt) {
+  for (std::size_t k = 0; k < n; ++k) {
     const PickoffOutput p = resonator_.measured();
-    const double burst = burst_left_s_ > 0.0 ? burst_rms_v_ : 0.0;
-    const std::array<double, 2> volts{p.x_v, p.y_v};
+    volts_[2 * k] = p.x_v + config_.adc.offset_v[0];
+    volts_[2 * k + 1] = p.y_v + config_.adc.offset_v[1];
+    resonator_.step(drives_[k], dt);
+  }
+}
+
+void SimTarget::add_noise(std::size_t n, double dt) {
+  const auto& rms = config_.adc.noise_v_rms;
+  if (rms[0] == 0.0 && rms[1] == 0.0 && !(burst_left_s_ > 0.0)) return;
+  noise_.fill(noise_buf_.data(), 2 * n);
+  // hypot only while a burst is on (it may end within the chunk).
+  std::array<double, 2> burst_rms = rms;
+  if (burst_left_s_ > 0.0)
+    burst_rms = {std::hypot(rms[0], burst_rms_v_), std::hypot(rms[1], burst_rms_v_)};
+  for (std::size_t k = 0; k < n; ++k) {
+    const bool burst = burst_left_s_ > 0.0;
+    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch)
+      volts_[2 * k + ch] += (burst ? burst_rms[ch] : rms[ch]) * noise_buf_[2 * k + ch];
+    if (burst) burst_left_s_ -= dt;
+  }
+}
+
+uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
+  uint32_t clipped = 0;
+  for (std::size_t k = 0; k < n; ++k) {
     for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch) {
-      double v = volts[ch] + config_.adc.offset_v[ch];
-      const double rms = std::hypot(config_.adc.noise_v_rms[ch], burst);
-      if (rms > 0.0) v += rms * noise_.normal();
       bool clip = false;
-      hal::q31_t word = adc_q_.convert(v, clip);
-      if (adc_saturated_[ch]) {
-        word = adc_q_.convert(1e300, clip);
-      }
+      hal::q31_t word = adc_q_.convert(volts_[2 * k + ch], clip);
+      if (adc_saturated_[ch]) word = adc_q_.convert(1e300, clip);
       if (adc_stuck_[ch]) {
         word = adc_last_[ch];
         clip = false;
       }
       adc_last_[ch] = word;
       if (clip) ++clipped;
-      frames[2 * k + ch] = word;
+      out[2 * k + ch] = word;
     }
-    const Drive d = next_drive();
-    last_pump_v_ = d.pump_v;
-    resonator_.step(d, dt);
-    ++sample_index_;
-    if (burst_left_s_ > 0.0) burst_left_s_ -= dt;
+  }
+  return clipped;
+}
+
+Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
+                                uint32_t& clipped) {
+  const uint32_t n = config_.adc.block_frames;
+  if (frames.size() != static_cast<std::size_t>(n) * hal::kAdcChannels) {
+    return Status::invalid_argument;
+  }
+  StageLaps laps(profiling_ ? &stage_times_ : nullptr);
+  const double dt = 1.0 / config_.adc.sample_rate_hz;
+  const double t0 = time_s();
+  t_first_ns = sample_time_ns(sample_index_);
+  clipped = 0;
+  // In chunks of kChunk samples, stage by stage: the DAC's drives, the
+  // resonator (pickoffs at t_k, then one step under drive k), the pickoff
+  // noise in one draw, the ADC. Sample k sees the same inputs as when the
+  // stages were interleaved per sample.
+  for (std::size_t done = 0; done < n; done += kChunk) {
+    const std::size_t m = std::min<std::size_t>(kChunk, n - done);
+    for (std::size_t k = 0; k < m; ++k)
+      drives_[k] = next_drive();
+    last_pump_v_ = drives_[m - 1].pump_v;
+    laps.lap(&SimStageTimes::dac_ns);
+    run_resonator(m, dt);
+    sample_index_ += m;
+    laps.lap(&SimStageTimes::resonator_ns);
+    add_noise(m, dt);
+    laps.lap(&SimStageTimes::noise_ns);
+    clipped += quantize(m, frames.data() + 2 * done);
+    laps.lap(&SimStageTimes::adc_ns);
   }
   // Input angle: the exact integral of the rate profile over the block.
   const double t1 = time_s();
@@ -183,6 +245,8 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   can_.tick(t1 - t0);
   counters_.adc_clipped += clipped;
   ++counters_.blocks;
+  stage_times_.samples += n;
+  laps.lap(&SimStageTimes::block_ns);
   return Status::ok;
 }
 

@@ -313,3 +313,31 @@ TEST(SimBoard, NoiseBurstRaisesTheNoiseForItsDurationOnly) {
   DOUBLES_EQUAL(1e-2, std::sqrt(in_burst / 400.0), 1.5e-3);
   DOUBLES_EQUAL(1e-4, std::sqrt(after / 400.0), 1.5e-5);
 }
+
+TEST(SimBoard, BlockSizeAndProfilingDoNotChangeTheSamples) {
+  // The board works in chunks of 128 samples: one block of 300 frames
+  // (128 + 128 + 44) must give the bits of three blocks of 100.
+  SimConfig c;
+  c.adc.noise_v_rms = {1e-4, 2e-4};
+  c.initial.amplitude_v = 1.0;
+  c.seed = 7;
+  uint64_t t_ns = 0;
+  uint32_t clipped = 0;
+  target().configure(c);
+  std::vector<hal::q31_t> small;
+  for (int i = 0; i < 3; ++i) {
+    const auto v = read_one(hal::board(), t_ns, clipped);
+    small.insert(small.end(), v.begin(), v.end());
+  }
+  const SimStageTimes& off = target().stage_times();
+  CHECK_EQUAL(0u, off.dac_ns + off.resonator_ns + off.noise_ns + off.adc_ns + off.block_ns);
+  c.adc.block_frames = 300;
+  target().configure(c);
+  target().set_profiling(true);
+  const auto big = read_one(hal::board(), t_ns, clipped);
+  target().set_profiling(false);
+  CHECK(small == big);
+  const SimStageTimes& st = target().stage_times();
+  CHECK_EQUAL(300u, st.samples);
+  CHECK(st.resonator_ns > 0 && st.noise_ns > 0 && st.adc_ns > 0);
+}

@@ -13,6 +13,7 @@
 
 #include "sim_tools/console.hpp"
 #include "sim_tools/job.hpp"
+#include "sim_tools/profile_report.hpp"
 #include "sim_tools/report.hpp"
 #include "sim_tools/scenario_job.hpp"
 
@@ -23,7 +24,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
     "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
-    "               [--no-control-drift] [--quiet]\n\n"
+    "               [--no-control-drift] [--profile] [--quiet]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -41,6 +42,8 @@ constexpr const char* kUsage =
     "SCHED_FIFO and mlockall when permitted) and counts deadline misses.\n"
     "--no-control-drift leaves the control-loop drift D_Phi out of the output\n"
     "(the resonator model is still applied), for comparison.\n"
+    "--profile prints where the host time goes: per firmware task and per stage\n"
+    "of the simulated target (drives, resonator, noise, ADC).\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
 
 bool parse_double(std::string_view s, double& out) {
@@ -59,7 +62,7 @@ struct SimOptions {
   std::string scenario, out_dir = "sim-out", can_log;
   double duration_s = 0.0;
   int bias_angles = 0;  // not given: the schedule's default
-  bool plots = true, quiet = false, real_time = false, static_base = false;
+  bool plots = true, quiet = false, real_time = false, static_base = false, profile = false;
   bool control_drift = true;
 };
 
@@ -108,6 +111,8 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
       o.plots = false;
     } else if (a == "--quiet") {
       o.quiet = true;
+    } else if (a == "--profile") {
+      o.profile = true;
     } else {
       std::fprintf(stderr, "hrg sim: unknown option '%s'\n\n%s", args[i], kUsage);
       return 2;
@@ -172,6 +177,7 @@ int sim_main(std::span<char* const> args) {
     opt.progress = !o.quiet && simtools::stderr_is_terminal();
     opt.can_log = o.can_log;
     opt.real_time = o.real_time;
+    opt.profile = o.profile;
     r = simtools::run_job(job, opt);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
@@ -185,6 +191,7 @@ int sim_main(std::span<char* const> args) {
     return 2;
   }
   if (!o.quiet) simtools::print_summary(stdout, job, r);
+  if (o.profile) std::fputs(simtools::format_profile(r).c_str(), stdout);
   if (o.plots) plot(dir, o.quiet);
   if (!o.quiet) std::fprintf(stderr, "hrg sim: results in %s\n", o.out_dir.c_str());
   return passed ? 0 : 1;

@@ -47,6 +47,16 @@ struct SimCounters {
   uint64_t dac_underruns = 0;  // DAC frames output as zero because no block was queued
 };
 
+// Host time spent in each stage of the ADC's read_block (profiling only).
+struct SimStageTimes {
+  uint64_t dac_ns = 0;        // queued DAC frames -> quantised drive voltages
+  uint64_t resonator_ns = 0;  // pickoffs and the full-rate step
+  uint64_t noise_ns = 0;      // Gaussian pickoff noise
+  uint64_t adc_ns = 0;        // ADC quantisation and faults
+  uint64_t block_ns = 0;      // per block: input angle, true wave angle, CAN bus time
+  uint64_t samples = 0;
+};
+
 class SimTarget {
  public:
   SimTarget();
@@ -74,6 +84,10 @@ class SimTarget {
 
   TrueState true_state() const;
   SimCounters counters() const { return counters_; }
+  // Stage timing of read_block: two host clock reads per stage per chunk of
+  // kChunk samples while on, none while off (the default).
+  void set_profiling(bool on) { profiling_ = on; }
+  const SimStageTimes& stage_times() const { return stage_times_; }
   Resonator& resonator() { return resonator_; }
   SimCan& can() { return can_; }
   double time_s() const;
@@ -114,8 +128,15 @@ class SimTarget {
   };
   using DacFrame = std::array<hal::q31_t, hal::kDacChannels>;
 
+  // A block is produced in chunks of at most kChunk samples through fixed
+  // buffers (nothing is allocated while running).
+  static constexpr std::size_t kChunk = 128;
+
   hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
                             uint32_t& clipped);
+  void run_resonator(std::size_t n, double dt);
+  void add_noise(std::size_t n, double dt);
+  uint32_t quantize(std::size_t n, hal::q31_t* out);
   Drive next_drive();
   uint64_t sample_time_ns(uint64_t index) const;
 
@@ -151,6 +172,11 @@ class SimTarget {
   double input_angle_rad_ = 0.0;
   double last_pump_v_ = 0.0;
   SimCounters counters_;
+  bool profiling_ = false;
+  SimStageTimes stage_times_;
+  std::array<Drive, kChunk> drives_{};
+  std::array<double, 2 * kChunk> volts_{};
+  std::array<double, 2 * kChunk> noise_buf_{};
 };
 
 // The instance behind hrg::hal::board() (configured with SimConfig{} on first use).

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "audit/bench.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <random>
+#include <string>
 
+#include "batch/batch.hpp"
 #include "campaign.hpp"
 
 namespace hrg::audit {
@@ -14,6 +18,16 @@ namespace {
 
 using bench::Design;
 using bench::Scenario;
+
+// printf into a string (the --verbose lines of one design, printed in order later).
+[[gnu::format(printf, 1, 2)]] std::string fmt_line(const char* f, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, f);
+  std::vsnprintf(buf, sizeof buf, f, ap);
+  va_end(ap);
+  return buf;
+}
 
 // Conceals effect `e` with catalogue value `v` in the scenario.
 void conceal(Scenario& s, Effect e, double v, std::mt19937_64& g) {
@@ -84,10 +98,22 @@ int top_of(const AuditResult& r, double& value) {
 
 }  // namespace
 
-BenchResult run_benchmark(const BenchOptions& o) {
+namespace {
+
+// One design's recordings (its null twin, then one per testable effect) and
+// their audits: what run_benchmark adds up. Shares nothing with other designs.
+struct DesignPart {
   BenchResult res;
   double audit_s = 0.0;
   int audits = 0;
+  std::string log;  // the --verbose lines, printed in design order
+};
+
+DesignPart run_design(const BenchOptions& o, int d) {
+  DesignPart part;
+  BenchResult& res = part.res;
+  double& audit_s = part.audit_s;
+  int& audits = part.audits;
   auto timed_audit = [&](const recording::Recording& rec) {
     const auto t0 = std::chrono::steady_clock::now();
     AuditResult r = run_audit(rec);
@@ -96,7 +122,7 @@ BenchResult run_benchmark(const BenchOptions& o) {
     ++audits;
     return std::make_pair(r, s);
   };
-  for (int d = 0; d < o.designs; ++d) {
+  {
     const Design kind = design_of(o, d);
     const uint64_t seed = o.seed * 100003ULL + static_cast<uint64_t>(d);
     const Scenario base =
@@ -114,8 +140,8 @@ BenchResult run_benchmark(const BenchOptions& o) {
     if (nc.top >= 0) ++res.null_findings;
     res.confusion[kEffectCount][nc.top >= 0 ? static_cast<std::size_t>(nc.top) : kEffectCount]++;
     if (o.verbose) {
-      std::fprintf(stderr, "design %d (%s) null: %s\n", d, bench::design_name(kind),
-                   null_r.verdict.c_str());
+      part.log += fmt_line("design %d (%s) null: %s\n", d, bench::design_name(kind),
+                           null_r.verdict.c_str());
     }
     std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -157,13 +183,45 @@ BenchResult run_benchmark(const BenchOptions& o) {
         if (c.top == c.truth) ++res.below1x_found;
       }
       if (o.verbose) {
-        std::fprintf(stderr, "  %-24s x%.2f true %.4g -> %s %s %.4g%s\n",
-                     effect_info(cand.effect).id, c.strength, c.true_value, r.verdict.c_str(),
+        part.log +=
+            fmt_line("  %-24s x%.2f true %.4g -> %s %s %.4g%s\n", effect_info(cand.effect).id,
+                     c.strength, c.true_value, r.verdict.c_str(),
                      c.top >= 0 ? effect_info(static_cast<Effect>(c.top)).id : "-", c.top_value,
                      c.strength >= 2.0 && !is_hit(c) ? "   <-- MISS" : "");
       }
       res.cases.push_back(c);
     }
+  }
+  return part;
+}
+
+}  // namespace
+
+// Designs run in parallel (o.jobs threads) and are added up in design order:
+// the same result and output for any thread count.
+BenchResult run_benchmark(const BenchOptions& o) {
+  const auto parts =
+      batch::run_indexed(static_cast<std::size_t>(std::max(o.designs, 0)), o.jobs,
+                         [&o](std::size_t d) { return run_design(o, static_cast<int>(d)); });
+  BenchResult res;
+  double audit_s = 0.0;
+  int audits = 0;
+  for (const DesignPart& p : parts) {
+    if (o.verbose) std::fputs(p.log.c_str(), stderr);
+    const BenchResult& r = p.res;
+    res.cases.insert(res.cases.end(), r.cases.begin(), r.cases.end());
+    for (std::size_t i = 0; i < res.confusion.size(); ++i)
+      for (std::size_t j = 0; j < res.confusion[i].size(); ++j)
+        res.confusion[i][j] += r.confusion[i][j];
+    res.above2x += r.above2x;
+    res.above2x_hits += r.above2x_hits;
+    res.nulls += r.nulls;
+    res.null_findings += r.null_findings;
+    res.below1x += r.below1x;
+    res.below1x_found += r.below1x_found;
+    res.unscored += r.unscored;
+    audit_s += p.audit_s;
+    audits += p.audits;
   }
   res.mean_audit_s = audits ? audit_s / audits : 0.0;
   return res;

@@ -10,6 +10,7 @@
 #include "audit/audit.hpp"
 #include "audit/audit_command.hpp"
 #include "audit/bench.hpp"
+#include "batch/batch.hpp"
 #include "campaign.hpp"
 #include "recording/recording.hpp"
 
@@ -19,14 +20,16 @@ namespace {
 
 void bench_usage(std::FILE* f) {
   std::fprintf(f,
-               "usage: hrg audit-bench [--n DESIGNS] [--seed S] [--speed-hours H] [--verbose]\n\n"
+               "usage: hrg audit-bench [--n DESIGNS] [--seed S] [--jobs N] [--speed-hours H]\n"
+               "                       [--verbose]\n\n"
                "Simulates DESIGNS random resonators and campaigns in turn: a ring-down campaign\n"
                "and envelope-controlled telemetry (sim_target's averaged model), and the\n"
                "firmware's own telemetry (firmware + full-rate sim_target, as hrg sim runs it).\n"
                "Each gives one null recording and one recording per catalogue effect concealed\n"
                "at 0.3x-3x its detection threshold. Prints the confusion matrix, the hit rate\n"
                "above 2x, the false-finding rate on nulls and the confusable pairs, then times\n"
-               "the audit of an H-hour 200 Hz recording (0: skip).\n\n"
+               "the audit of an H-hour 200 Hz recording (0: skip). --jobs N runs N designs at a\n"
+               "time (default 0: all cores); the results and the output do not depend on N.\n\n"
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "writes one simulated campaign, optionally with one catalogue effect (a\n"
@@ -68,6 +71,7 @@ double speed_run(double hours, uint64_t seed) {
 
 int audit_bench_main(std::span<char* const> args) {
   BenchOptions o;
+  o.jobs = batch::all_cores();
   double hours = 1.0;
   std::string emit, design_arg = "ringdown", effect;
   double duration_s = 480.0, value = 0.0, noise_v = -1.0;
@@ -79,6 +83,12 @@ int audit_bench_main(std::span<char* const> args) {
       return 0;
     } else if (a == "--n" && has_value) {
       o.designs = std::atoi(args[++i]);
+    } else if (a == "--jobs" && has_value) {
+      if (!batch::parse_jobs(args[++i], o.jobs)) {
+        std::fprintf(stderr, "hrg audit-bench: --jobs '%s' is not a count (0: all cores)\n",
+                     args[i]);
+        return 2;
+      }
     } else if (a == "--seed" && has_value) {
       o.seed = std::strtoull(args[++i], nullptr, 10);
     } else if (a == "--speed-hours" && has_value) {

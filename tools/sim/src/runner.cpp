@@ -44,9 +44,10 @@ sim::TrueState midpoint(const sim::TrueState& a, const sim::TrueState& b) {
 // in real time CLOCK_MONOTONIC does both, with the simulated converters
 // behind it.
 struct Rig {
+  explicit Rig(hal::Board& sim) : sim_board(sim) {}
   HostClock host_timer;
   hal::linux_board::LinuxClock rt_clock;
-  hal::Board& sim_board = hal::board();  // the simulated target, chosen at link time
+  hal::Board& sim_board;
   hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
                       sim_board.fault_input, sim_board.can, rt_clock};
 };
@@ -295,9 +296,12 @@ void summarise_speed(JobResult& r, const fw::Gyro& gyro, uint64_t frames, double
 
 JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   JobResult r;
-  sim::SimTarget& target = sim::target();
+  // A simulated target of its own: runs in parallel threads share nothing.
+  const auto own_target = std::make_unique<sim::SimTarget>();
+  sim::SimTarget& target = *own_target;
   target.configure(job.sim);
-  Rig rig;
+  target.set_profiling(opt.profile);
+  Rig rig(target.board());
   const std::unique_ptr<fw::app::Firmware> firmware = build_firmware(job, rig, opt, r);
   const fw::Gyro& gyro = firmware->gyro();
   std::unique_ptr<can::CandumpLogWriter> log;
@@ -341,6 +345,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   r.can_restarts = gyro.can_restarts();
   summarise_identification(r, job, *firmware);
   summarise_executive(r, gyro);
+  r.sim_stages = target.stage_times();
   if (log) log->flush();
   analyse_run(r, job);
   return r;

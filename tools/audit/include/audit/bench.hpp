@@ -27,6 +27,7 @@ struct BenchOptions {
   double telemetry_s = 360.0;
   bool firmware = true;  // every third design is the firmware's telemetry
   bool verbose = false;
+  unsigned jobs = 1;  // designs simulated and audited in parallel (same result for any count)
 };
 
 struct BenchCase {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "firmware/app/firmware_config.hpp"
+#include "sim_target/control.hpp"
 #include "sim_target/sim_config.hpp"
 #include "sim_tools/analysis.hpp"
 
@@ -116,6 +117,7 @@ struct JobResult {
   double realtime_factor_cpu = 0.0;  // simulated s per CPU s (what one free core gives)
   double sim_share = 0.0;            // share of the wall time spent in the simulated ADC (physics)
   double adc_wait_mean_us = 0.0;     // mean time per frame inside Adc::read_block (the simulation)
+  sim::SimStageTimes sim_stages;     // host time per stage of read_block (RunOptions::profile)
   double excitation_off_fraction = 0.0;
   uint32_t windows = 0;
   uint32_t windows_accepted = 0;
@@ -161,6 +163,7 @@ struct RunOptions {
   std::string can_log;     // when not empty: every CAN frame as a candump log
   bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
   int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
+  bool profile = false;    // time the simulated target's stages (JobResult::sim_stages)
 };
 
 // Runs firmware + simulated target: in lockstep (as fast as the host allows,

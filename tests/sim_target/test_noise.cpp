@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: MIT
+// The simulated board's Gaussian (xoshiro256** + ziggurat): 1e7 draws against
+// the normal distribution's moments, tail probabilities and histogram, and no
+// correlation from one draw to the next. Bounds are 5 standard errors of each
+// statistic for N draws (the seed is fixed, so the test is deterministic).
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "sim_target/noise.hpp"
+
+#include "support/cpputest.hpp"
+
+namespace {
+constexpr std::size_t kN = 10'000'000;
+
+double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+}  // namespace
+
+TEST_GROUP(Gaussian){};
+
+TEST(Gaussian, MomentsTailsAndHistogramAreTheNormalOnes) {
+  hrg::sim::detail::Gaussian g(20240531);
+  std::vector<double> x(kN);
+  g.fill(x.data(), kN);
+  const double n = static_cast<double>(kN);
+  double m1 = 0, m2 = 0, m4 = 0, lag1 = 0;
+  std::size_t beyond2 = 0, beyond3 = 0, beyond4 = 0;
+  constexpr int kBins = 40;  // width 0.25 over [-5, 5)
+  std::vector<double> hist(kBins, 0.0);
+  for (std::size_t i = 0; i < kN; ++i) {
+    const double v = x[i];
+    m1 += v;
+    m2 += v * v;
+    m4 += v * v * v * v;
+    if (i > 0) lag1 += v * x[i - 1];
+    const double a = std::fabs(v);
+    beyond2 += a > 2.0;
+    beyond3 += a > 3.0;
+    beyond4 += a > 4.0;
+    const int b = static_cast<int>(std::floor((v + 5.0) / 0.25));
+    if (b >= 0 && b < kBins) hist[static_cast<std::size_t>(b)] += 1.0;
+  }
+  m1 /= n;
+  m2 /= n;
+  m4 /= n;
+  lag1 /= n - 1.0;
+  CHECK(std::fabs(m1) < 5.0 / std::sqrt(n));
+  CHECK(std::fabs(m2 - 1.0) < 5.0 * std::sqrt(2.0 / n));
+  CHECK(std::fabs(m4 - 3.0) < 5.0 * std::sqrt(96.0 / n));
+  CHECK(std::fabs(lag1) < 5.0 / std::sqrt(n));
+  const double tails[3] = {2.0, 3.0, 4.0};
+  const std::size_t counts[3] = {beyond2, beyond3, beyond4};
+  for (int k = 0; k < 3; ++k) {
+    const double p = 2.0 * normal_cdf(-tails[k]);  // 4.55e-2, 2.70e-3, 6.33e-5
+    const double c = static_cast<double>(counts[k]);
+    CHECK(std::fabs(c - n * p) < 5.0 * std::sqrt(n * p * (1.0 - p)));
+  }
+  // Chi-square over the bins with an expectation of at least 50 draws:
+  // mean = degrees of freedom, 5 standard deviations = 5 sqrt(2 dof).
+  double chi2 = 0.0;
+  int dof = -1;
+  for (int b = 0; b < kBins; ++b) {
+    const double lo = -5.0 + 0.25 * b;
+    const double expect = n * (normal_cdf(lo + 0.25) - normal_cdf(lo));
+    if (expect < 50.0) continue;
+    const double d = hist[static_cast<std::size_t>(b)] - expect;
+    chi2 += d * d / expect;
+    ++dof;
+  }
+  CHECK(dof > 30);
+  CHECK(chi2 < dof + 5.0 * std::sqrt(2.0 * dof));
+}
+
+TEST(Gaussian, FillGivesTheSameDrawsAsNormalInTurn) {
+  hrg::sim::detail::Gaussian a(7);
+  hrg::sim::detail::Gaussian b(7);
+  double block[1000];
+  a.fill(block, 1000);
+  for (double v : block)
+    CHECK_EQUAL(b.normal(), v);
+}

@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// `hrg sim --profile`: where the host time of a lockstep run goes, per
+// firmware task (the executive's own timings) and per stage of the simulated
+// target's read_block (SimTarget::set_profiling), so a speed regression shows
+// which part grew.
+
+#include <string>
+
+#include "sim_tools/job.hpp"
+
+namespace hrg::simtools {
+
+std::string format_profile(const JobResult& r);
+
+}  // namespace hrg::simtools
