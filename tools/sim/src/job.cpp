@@ -431,18 +431,24 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   const std::clock_t cpu0 = std::clock();
   std::size_t next_fault = 0;
   fw::Mode last_mode = fw::Mode::power_up;
-  // NCO phase minus 2 pi f_ref t at the end of this block and the two before.
-  double ref_offset_hist[3] = {0.0, 0.0, 0.0};
-  // The true state at the same three instants.
-  sim::TrueState true_hist[3];
+  // The demodulator's output describes the envelope at the centre of its
+  // window, dsp::kDecimatorOrder / 2 blocks before the block end (within a
+  // sample, dsp::decimator_group_delay_samples): half-way between the states
+  // kCentre and kCentre + 1 blocks back.
+  constexpr std::size_t kCentre = dsp::kDecimatorOrder / 2;
+  constexpr std::size_t kHist = kCentre + 2;
+  // NCO phase minus 2 pi f_ref t at the end of this block and the ones before.
+  double ref_offset_hist[kHist] = {};
+  // The true state at the same instants.
+  sim::TrueState true_hist[kHist];
   // A row is free of any drive once the last driven DAC word (played
   // dac_lead_frames + the DAC's pipeline latency after its block) lies before
-  // the 3 L - 2 samples the demodulator averages: exc = 0 only from then on.
+  // the N (L - 1) + 1 samples the demodulator averages: exc = 0 only from then on.
   const double block_frames = static_cast<double>(job.chain.block_frames);
   const auto drive_free_blocks =
       static_cast<uint64_t>(1.0 + std::ceil((job.chain.dac_lead_frames +
                                              static_cast<double>(job.sim.dac.latency_samples) +
-                                             2.0 * block_frames - 2.0) /
+                                             (dsp::kDecimatorOrder - 1.0) * (block_frames - 1.0)) /
                                             block_frames));
   uint64_t off_blocks = drive_free_blocks;  // blocks since the excitation was last on
   for (uint64_t k = 0; k < frames; ++k) {
@@ -468,11 +474,11 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       // fixed reference 2 pi f_ref t.
       const double nco_cycles = static_cast<double>(chain.chain().nco_phase()) * 0x1p-32;
       const double ref_cycles = std::fmod(job.chain.f_center_hz * st.chain.t_s, 1.0);
-      ref_offset_hist[2] = ref_offset_hist[1];
-      ref_offset_hist[1] = ref_offset_hist[0];
+      for (std::size_t i = kHist - 1; i > 0; --i) {
+        ref_offset_hist[i] = ref_offset_hist[i - 1];
+        true_hist[i] = true_hist[i - 1];
+      }
       ref_offset_hist[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
-      true_hist[2] = true_hist[1];
-      true_hist[1] = true_hist[0];
       true_hist[0] = target.true_state();
     }
     if (st.mode != last_mode) {
@@ -506,14 +512,14 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       r.can_frames += target.can().sent().size();
       target.can().clear_sent();
     }
-    if (k % row_every != 0 || k < 2) continue;  // rows from a full history on
-    // The decimating filter's output is centred 1.5 L - 1 samples before the
-    // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
-    // states one and two blocks back. Rate, temperature and the true angles
+    if (k % row_every != 0 || k + 1 < kHist) continue;  // rows from a full history on
+    // The decimating filter's output is centred N (L - 1) / 2 samples before
+    // the block's last sample, i.e. N / 2 blocks before t_s (N = 5): half-way
+    // between the states kCentre and kCentre + 1 blocks back. Rate, temperature and the true angles
     // are written at that instant: stamped at the block end instead, a rate
     // ramp of 10 deg/s^2 puts a 0.015 deg/s error into the input rate the
     // envelope saw, which the audit takes for a pickoff gain mismatch.
-    const sim::TrueState ts = midpoint(true_hist[1], true_hist[2]);
+    const sim::TrueState ts = midpoint(true_hist[kCentre], true_hist[kCentre + 1]);
     if (!have_ref && st.out_valid) {
       // Angles are compared from the first valid output on.
       true0 = ts.input_angle_rad;
@@ -522,8 +528,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       have_ref = true;
     }
     const double ref_offset_rad =
-        ref_offset_hist[1] +
-        0.5 * std::remainder(ref_offset_hist[2] - ref_offset_hist[1], 2.0 * kPi);
+        ref_offset_hist[kCentre] +
+        0.5 * std::remainder(ref_offset_hist[kCentre + 1] - ref_offset_hist[kCentre], 2.0 * kPi);
     record_row(r, job, *gyro, ts, ref_offset_rad, off_blocks >= drive_free_blocks, true0, out0,
                raw0);
     if (progress && k % 1000 == 0) {
