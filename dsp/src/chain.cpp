@@ -58,11 +58,18 @@ const char* check_resonance_band(const ChainConfig& c) {
   m.text(" Hz that sample_rate_hz ").num(c.sample_rate_hz).text(" with block_frames ");
   m.num(c.block_frames).text(" serves (2f image >= 100 dB down); ");
   const double need = std::pow(10.0, kImageRejectionDb / (20.0 * kDecimatorOrder));
-  if (low) {
+  if (band.lo_hz > band.hi_hz) {
+    m.text("the block is too short for any resonance: raise block_frames to at least ");
+    m.num(std::floor(need) + 1.0);
+  } else if (low) {
     // |sin(pi 2 f_min / fs)| >= need / L: the shortest block that serves f_min.
     const double l_min = std::ceil(need / std::sin(2.0 * kPi * c.f_min_hz / c.sample_rate_hz));
-    m.text("raise block_frames to at least ").num(l_min).text(" (control rate ");
-    m.num(c.sample_rate_hz / l_min).text(" Hz)");
+    if (l_min <= kMaxBlockFrames) {
+      m.text("raise block_frames to at least ").num(l_min).text(" (control rate ");
+      m.num(c.sample_rate_hz / l_min).text(" Hz)");
+    } else {
+      m.text("even the longest block (2000 frames) does not serve it: lower sample_rate_hz");
+    }
   } else {
     // 2 f_max <= (1 - a) fs with a from the block length.
     const double a = std::asin(need / c.block_frames) / kPi;

@@ -72,7 +72,15 @@ TEST(ChainConfig, DefaultsAreUsableAndBadFieldsAreNamed) {
   c.f_center_hz = 10000.0;
   c.f_max_hz = 10010.0;
   STRCMP_CONTAINS("f_max_hz 10010 Hz is outside the resonance band", check_chain_config(c));
-  STRCMP_CONTAINS("sample rate too low: raise sample_rate_hz to at least", check_chain_config(c));
+  STRCMP_CONTAINS("sample rate too low: raise sample_rate_hz to at least 24025",
+                  check_chain_config(c));
+  c.sample_rate_hz = 24025.0;
+  CHECK(check_chain_config(c) == nullptr);
+  // a block too short for 100 dB anywhere (L^5 sin^5 <= 1e5 needs L > 10)
+  c = ChainConfig{};
+  c.block_frames = 10;
+  STRCMP_CONTAINS("too short for any resonance: raise block_frames to at least 11",
+                  check_chain_config(c));
 }
 
 TEST(ChainConfig, AnUnusableConfigurationMakesProcessRefuse) {
