@@ -184,13 +184,13 @@ TEST(Chain, FixedDriveSynthesisMatchesTheDoubleChainWithin1024Lsb) {
     const auto adc = tone_block(100, 5000.3, 0.02, b * 1e-3);
     cq.process(adc, dq);
     cd.process(adc, dd);
-    // THEN every DAC word agrees within 1024 LSB of Q1.31 (5e-7 of full
+    // THEN every DAC word agrees within 1024 LSB of Q1.31 (4.8e-7 of full
     // scale). Synthesis itself adds ~2 LSB (table and product rounding); the
-    // rest is the measured wave phase that steers the drive: the quadratures
-    // agree within the demodulator's 2^3 + 1/2 LSB, i.e. 8.5 / (0.02 * 2^31)
-    // = 2e-7 rad at this small signal, times a drive word of 0.5 * 2^31 = 213
-    // LSB per block, and the PLL integrates the phase differences of the
-    // filling blocks into the NCO phase (measured 778 LSB).
+    // rest is the drive phase. The two chains' wave phases differ by up to
+    // 1.5e-7 rad: LSB-level differences of the quadratures of this 0.02 FS
+    // wave (1 LSB = 2.3e-8 rad), largest while the decimator fills, which the
+    // PLL integrates into the NCO phase. Times the pump word at full scale
+    // (2^31 LSB per rad) that is a few hundred LSB (measured 778).
     // (once the decimator is full: before, the wave is a small fraction of it)
     for (std::size_t k = 0; k < dq.size() && b >= static_cast<int>(kDecimatorOrder); ++k)
       worst = std::max(worst, std::labs(static_cast<long>(dq[k]) - static_cast<long>(dd[k])));

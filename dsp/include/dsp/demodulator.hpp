@@ -35,7 +35,7 @@
 // - Input scaling: interleaved Q1.31 frames [x0, y0, x1, y1, ...], 1.0 = ADC
 //   full scale; outputs in the same units (|c|, |s| <= 1).
 // - Q1.31: each mixing product is rounded to nearest (ties up) at
-//   2^-(31 - h), h = headroom_bits() the smallest shift with L^N <= 2^(31 + h)
+//   2^-(31 - h), h = headroom_bits() the smallest shift >= 1 with L^N <= 2^(31 + h)
 //   (h = 3 for L = 100), so every moment and the filter sum stay below 2^62:
 //   no overflow anywhere for any input, the block combination is exact
 //   (modulo 2^64 arithmetic whose true result is in range). The output
@@ -181,12 +181,12 @@ class Demodulator {
 
   uint32_t block_frames() const { return l_; }
 
-  // Q1.31 headroom shift h: the smallest h >= 0 with L^N <= 2^(31 + h).
+  // Q1.31 headroom shift h: the smallest h >= 1 with L^N <= 2^(31 + h).
   static constexpr int headroom_bits(uint32_t l) {
     uint64_t p = 1;
     for (uint32_t i = 0; i < kN; ++i)
       p *= l;
-    int h = 0;
+    int h = 1;  // at least 1: the product's high word then carries the result
     while (p > (uint64_t{1} << (31 + h)))
       ++h;
     return h;
@@ -255,7 +255,10 @@ class Demodulator {
 
   HRG_DSP_INLINE static sum_t mix(T x, T ref, int shift) {
     if constexpr (Ops::kFixed) {
-      return rshift_q63_rnd(mul_q31_q63(x, ref), shift);
+      // shift = 32 + (h - 1) >= 32: round, then keep the high word and shift
+      // it; the result has |u| <= 2^30 (a 32-bit core needs no 64-bit shift).
+      const q63_t p = mul_q31_q63(x, ref) + (q63_t{1} << (shift - 1));
+      return static_cast<int32_t>(p >> 32) >> (shift - 32);
     } else {
       (void)shift;
       return Ops::mix(x, ref);
