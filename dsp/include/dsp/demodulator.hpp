@@ -41,7 +41,8 @@
 //   (modulo 2^64 arithmetic whose true result is in range). The output
 //   2 * sum * 2^h / L^N is rounded once to nearest (ties away from zero) and
 //   saturates (reachable only for a square wave at the rails). The output is
-//   within 2^(h-1) + 1/2 LSB of the exact filter of the exact products.
+//   within 2^h + 1/2 LSB of the exact filter of the exact products (the
+//   filter doubles the products' rounding error of at most 2^(h-1) LSB).
 // - Float: running sums in float within a block (L additions), the block
 //   combination and the carries in double; double: all double. No overflow.
 
