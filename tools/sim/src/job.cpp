@@ -515,10 +515,11 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     if (k % row_every != 0 || k + 1 < kHist) continue;  // rows from a full history on
     // The decimating filter's output is centred N (L - 1) / 2 samples before
     // the block's last sample, i.e. N / 2 blocks before t_s (N = 5): half-way
-    // between the states kCentre and kCentre + 1 blocks back. Rate, temperature and the true angles
-    // are written at that instant: stamped at the block end instead, a rate
-    // ramp of 10 deg/s^2 puts a 0.015 deg/s error into the input rate the
-    // envelope saw, which the audit takes for a pickoff gain mismatch.
+    // between the states kCentre and kCentre + 1 blocks back. Rate,
+    // temperature and the true angles are written at that instant: stamped at
+    // the block end instead, a rate ramp of 10 deg/s^2 puts a 0.015 deg/s
+    // error into the input rate the envelope saw (sinc^3 figure), which the
+    // audit takes for a pickoff gain mismatch.
     const sim::TrueState ts = midpoint(true_hist[kCentre], true_hist[kCentre + 1]);
     if (!have_ref && st.out_valid) {
       // Angles are compared from the first valid output on.
