@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <cstddef>
 
 namespace hrg::dsp {
 
@@ -11,6 +12,74 @@ constexpr double kPi = std::numbers::pi;
 
 double clamp_abs(double v, double lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
 double wrap_pi(double a) { return a - 2.0 * kPi * std::round(a / (2.0 * kPi)); }
+
+// Appends text / a non-negative integer to a fixed buffer (no heap, no stdio
+// on the target); truncates at the end.
+class Message {
+ public:
+  Message& text(const char* t) {
+    while (*t && n_ + 1 < sizeof(buf_))
+      buf_[n_++] = *t++;
+    buf_[n_] = 0;
+    return *this;
+  }
+  Message& num(double v) {
+    char d[24];
+    int k = 0;
+    auto u = static_cast<unsigned long long>(v < 0.0 ? 0.0 : (v > 1e18 ? 1e18 : v + 0.5));
+    do {
+      d[k++] = static_cast<char>('0' + u % 10);
+      u /= 10;
+    } while (u && k < 23);
+    char t[24];
+    for (int i = 0; i < k; ++i)
+      t[i] = d[k - 1 - i];
+    t[k] = 0;
+    return text(t);
+  }
+  const char* str() const { return buf_; }
+
+ private:
+  char buf_[320] = {};
+  std::size_t n_ = 0;
+};
+
+// The PLL range [f_min, f_max] must lie in the band where the decimator
+// rejects the 2f image by >= 100 dB (decimator_band). Below it the block is
+// too short; above it the sample rate is too low. The message names the
+// frequency, the band and the change that serves it.
+const char* check_resonance_band(const ChainConfig& c) {
+  const DecimatorBand band = decimator_band(c.sample_rate_hz, c.block_frames);
+  const bool low = c.f_min_hz < band.lo_hz;
+  const bool high = c.f_max_hz > band.hi_hz;
+  if (!low && !high) return nullptr;
+  static Message m;
+  m = Message{};
+  m.text("chain config: ").text(low ? "f_min_hz " : "f_max_hz ").num(low ? c.f_min_hz : c.f_max_hz);
+  m.text(" Hz is outside the resonance band ").num(band.lo_hz).text("..").num(band.hi_hz);
+  m.text(" Hz that sample_rate_hz ").num(c.sample_rate_hz).text(" with block_frames ");
+  m.num(c.block_frames).text(" serves (2f image >= 100 dB down); ");
+  const double need = std::pow(10.0, kImageRejectionDb / (20.0 * kDecimatorOrder));
+  if (band.lo_hz > band.hi_hz) {
+    m.text("the block is too short for any resonance: raise block_frames to at least ");
+    m.num(std::floor(need) + 1.0);
+  } else if (low) {
+    // |sin(pi 2 f_min / fs)| >= need / L: the shortest block that serves f_min.
+    const double l_min = std::ceil(need / std::sin(2.0 * kPi * c.f_min_hz / c.sample_rate_hz));
+    if (l_min <= kMaxBlockFrames) {
+      m.text("raise block_frames to at least ").num(l_min).text(" (control rate ");
+      m.num(c.sample_rate_hz / l_min).text(" Hz)");
+    } else {
+      m.text("even the longest block (2000 frames) does not serve it: lower sample_rate_hz");
+    }
+  } else {
+    // 2 f_max <= (1 - a) fs with a from the block length.
+    const double a = std::asin(need / c.block_frames) / kPi;
+    m.text("sample rate too low: raise sample_rate_hz to at least ");
+    m.num(std::ceil(2.0 * c.f_max_hz / (1.0 - a))).text(" with block_frames ").num(c.block_frames);
+  }
+  return m.str();
+}
 }  // namespace
 
 double pump_phase_error_rad(double prev_pump_phase_rad, double wave_phase_rad) {
@@ -23,23 +92,15 @@ double quad_force_rate_v_s(double forcer_gain_per_s2, double w_rad_s, double u_q
 
 const char* check_chain_config(const ChainConfig& c) {
   if (!(c.sample_rate_hz > 0.0)) return "chain config: sample_rate_hz must be > 0";
-  if (c.block_frames < 4 || c.block_frames > 2000)
+  if (c.block_frames < kMinBlockFrames || c.block_frames > kMaxBlockFrames)
     return "chain config: block_frames must be in [4, 2000]";
   if (!(c.adc_full_scale_v > 0.0)) return "chain config: adc_full_scale_v must be > 0";
   if (!(c.dac_full_scale_v > 0.0)) return "chain config: dac_full_scale_v must be > 0";
   if (!(c.dac_lead_frames >= 0.0 && c.dac_lead_frames < 1048576.0))
     return "chain config: dac_lead_frames must be in [0, 2^20)";
-  if (!(c.f_min_hz > 0.0 && c.f_min_hz <= c.f_center_hz && c.f_center_hz <= c.f_max_hz &&
-        c.f_max_hz < c.sample_rate_hz / 2.0))
-    return "chain config: need 0 < f_min_hz <= f_center_hz <= f_max_hz < sample_rate_hz / 2";
-  // Periodicity rule: the block must span (nearly) whole half-periods of 2f
-  // over the whole PLL range, or the 2f image leaks through the decimator.
-  for (int k = 0; k <= 8; ++k) {
-    const double f = c.f_min_hz + (c.f_max_hz - c.f_min_hz) * k / 8.0;
-    if (image_rejection_db(2.0 * f, c.sample_rate_hz, c.block_frames) > -100.0)
-      return "chain config: block_frames breaks the periodicity rule over [f_min_hz, f_max_hz]: "
-             "the 2f image would be rejected by less than 100 dB";
-  }
+  if (!(c.f_min_hz > 0.0 && c.f_min_hz <= c.f_center_hz && c.f_center_hz <= c.f_max_hz))
+    return "chain config: need 0 < f_min_hz <= f_center_hz <= f_max_hz";
+  if (const char* band = check_resonance_band(c)) return band;
   if (!(c.q_factor > 0.0)) return "chain config: q_factor must be > 0";
   if (!(c.pump_gain_per_s2_v2 > 0.0)) return "chain config: pump_gain_per_s2_v2 must be > 0";
   if (!(c.forcer_gain_per_s2 > 0.0)) return "chain config: forcer_gain_per_s2 must be > 0";

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Fast path of the chain (NCO, mixing, sinc^3 decimation, both channels) for
+// Fast path of the chain (NCO, mixing, sinc^5 decimation, both channels) for
 // instruction counting under callgrind: bench_fast_path.cmake runs
 //   valgrind --tool=callgrind --toggle-collect=hrg_bench_fast_path_<type>
 // and divides the instructions by the frames processed. Without valgrind the

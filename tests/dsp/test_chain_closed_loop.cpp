@@ -205,9 +205,9 @@ TEST(ClosedLoop, LoopsHoldWithPickoffNoise) {
     always_locked = always_locked && rig.out().locked;
   });
   // THEN the true amplitude holds within 1e-4 and the quadrature stays below
-  // 1e-4 a_A: the noise in each quadrature after the sinc^3 (equivalent noise
-  // bandwidth 0.55 / (L T) = 550 Hz of the 50 kHz band, times 2 for the
-  // mixing) is 3e-4 sqrt(2 * 550 / 50000) = 4.5e-5 V per block, and the loops
+  // 1e-4 a_A: the noise in each quadrature after the sinc^5 (equivalent noise
+  // bandwidth 0.44 / (L T) = 440 Hz of the 50 kHz band, times 2 for the
+  // mixing) is 3e-4 sqrt(2 * 440 / 50000) = 3.9e-5 V per block, and the loops
   // follow it only within their bandwidths
   const double mean = sum_a / static_cast<double>(n);
   const double rms = std::sqrt(std::fmax(0.0, sum_a2 / static_cast<double>(n) - mean * mean));

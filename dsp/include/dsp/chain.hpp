@@ -4,7 +4,7 @@
 // The whole-angle signal chain, called once per ADC block by the firmware:
 //
 //   ADC block (Q1.31 [x, y] frames)
-//     -> NCO + mixing + sinc^3 decimation (fast path, type T)  -> cx, sx, cy, sy
+//     -> NCO + mixing + sinc^5 decimation (fast path, type T)  -> cx, sx, cy, sy
 //     -> wave variables, theta_A unwrapping                    (control rate, double)
 //     -> PLL on the wave phase, AGC through the pump, quadrature nulling,
 //        optional pattern-angle command, ring-up from rest
@@ -89,7 +89,11 @@ struct ChainConfig {
 };
 
 // Returns nullptr when the configuration is usable, else a message naming the
-// first bad field.
+// first bad field. A PLL range outside the band the decimator serves
+// (decimator_band: 1594..48406 Hz at 100 kHz with 100-frame blocks) is
+// refused naming the frequency, the band and the block length or sample rate
+// that would serve it; that message is held in one static buffer, valid
+// until the next refused configuration.
 const char* check_chain_config(const ChainConfig& c);
 
 // Control-loop drift inputs (seed sections 6-7).

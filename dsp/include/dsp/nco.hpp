@@ -15,6 +15,7 @@
 #include <numbers>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "dsp/fixed.hpp"
 #include "dsp/sample.hpp"
@@ -102,6 +103,42 @@ HRG_DSP_INLINE T sin_turns(uint32_t phase) {
   } else {
     constexpr T kScale = T(1) / static_cast<T>(uint32_t{1} << kSineFracBits);
     return a + (b - a) * (static_cast<T>(frac) * kScale);
+  }
+}
+
+// Differences of neighbouring table entries, t[i + 1] - t[i] (the same
+// values sin_turns computes), so sincos_turns needs one load pair per output.
+template <typename T>
+struct SineDeltaTable {
+  using D = std::conditional_t<SampleOps<T>::kFixed, int32_t, T>;
+  static constexpr std::array<D, kSineTableSize> make() {
+    std::array<D, kSineTableSize> d{};
+    for (std::size_t i = 0; i < kSineTableSize; ++i)
+      d[i] = static_cast<D>(SineTable<T>::kValues[i + 1] - SineTable<T>::kValues[i]);
+    return d;
+  }
+  static constexpr std::array<D, kSineTableSize> kValues = make();
+};
+
+// cos and sin of one phase together, bit-identical to cos_turns / sin_turns
+// (same table, same interpolation and rounding); the fractional part is
+// shared, so it costs less than the two calls.
+template <typename T>
+HRG_DSP_INLINE void sincos_turns(uint32_t phase, T& c, T& s) {
+  const auto& t = SineTable<T>::kValues;
+  const auto& d = SineDeltaTable<T>::kValues;
+  const uint32_t is = phase >> kSineFracBits;
+  const uint32_t ic = (is + kSineTableSize / 4) & (kSineTableSize - 1);
+  const uint32_t frac = phase & ((uint32_t{1} << kSineFracBits) - 1u);
+  if constexpr (SampleOps<T>::kFixed) {
+    const q63_t f = static_cast<q63_t>(frac);
+    s = static_cast<T>(t[is] + rshift_q63_rnd(static_cast<q63_t>(d[is]) * f, kSineFracBits));
+    c = static_cast<T>(t[ic] + rshift_q63_rnd(static_cast<q63_t>(d[ic]) * f, kSineFracBits));
+  } else {
+    constexpr T kScale = T(1) / static_cast<T>(uint32_t{1} << kSineFracBits);
+    const T f = static_cast<T>(frac) * kScale;
+    s = t[is] + d[is] * f;
+    c = t[ic] + d[ic] * f;
   }
 }
 

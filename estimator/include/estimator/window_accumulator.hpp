@@ -25,13 +25,13 @@
 // a fraction (block/window)^2 of the information.
 //
 // Transient rule. An output of the demodulator depends on the pickoff samples
-// of its low-pass span: the sinc^3 decimator of dsp/demodulator.hpp has 3L - 2
-// taps, 2.98 ms for L = 100 at 100 kHz, i.e. the first 3 control-rate outputs
+// of its low-pass span: the sinc^5 decimator of dsp/demodulator.hpp has 5L - 4
+// taps, 4.96 ms for L = 100 at 100 kHz, i.e. the first 5 control-rate outputs
 // after the switch still hold samples taken with the drive on; the DAC adds up
 // to one block of latency before the drive is really off. Samples with
 // t_s < t_switch_s + settle_s are therefore ignored, with
-//   settle_s >= (3L - 2)/f_adc + DAC latency + one control period  (~5 ms).
-// The default 20 ms is four times that, and costs 0.4 % of a 5 s window.
+//   settle_s >= (5L - 4)/f_adc + DAC latency + one control period  (~7 ms).
+// The default 20 ms is about three times that, and costs 0.4 % of a 5 s window.
 //
 // Context: task level at the control rate; no heap, no exceptions.
 

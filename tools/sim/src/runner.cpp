@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "can/candump_log.hpp"
+#include "dsp/demodulator.hpp"
 #include "firmware/app/firmware.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
@@ -136,15 +137,23 @@ void drain_can(sim::SimTarget& target, can::CandumpLogWriter* log, double t_s, J
 // enough that the row's whole averaging span is free of it.
 class RowStamper {
  public:
+  // The demodulator's output describes the envelope at the centre of its
+  // window, dsp::kDecimatorOrder / 2 blocks before the block end (within a
+  // sample, dsp::decimator_group_delay_samples): half-way between the states
+  // kCentre and kCentre + 1 blocks back.
+  static constexpr std::size_t kCentre = dsp::kDecimatorOrder / 2;
+  static constexpr std::size_t kHistory = kCentre + 2;
+
   explicit RowStamper(const JobConfig& job) : f_ref_hz_(job.firmware.chain.f_center_hz) {
     // A row is free of any drive once the last driven DAC word (played
     // dac_lead_frames + the DAC's pipeline latency after its block) lies
-    // before the 3 L - 2 samples the demodulator averages.
+    // before the N (L - 1) + 1 samples the demodulator averages.
     const double l = static_cast<double>(job.firmware.chain.block_frames);
-    drive_free_blocks_ = static_cast<uint64_t>(
-        1.0 + std::ceil((job.firmware.chain.dac_lead_frames +
-                         static_cast<double>(job.sim.dac.latency_samples) + 2.0 * l - 2.0) /
-                        l));
+    drive_free_blocks_ =
+        static_cast<uint64_t>(1.0 + std::ceil((job.firmware.chain.dac_lead_frames +
+                                               static_cast<double>(job.sim.dac.latency_samples) +
+                                               (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
+                                              l));
     off_blocks_ = drive_free_blocks_;
   }
 
@@ -155,22 +164,24 @@ class RowStamper {
     // fixed reference 2 pi f_ref t.
     const double nco_cycles = static_cast<double>(firmware.chain().chain().nco_phase()) * 0x1p-32;
     const double ref_cycles = std::fmod(f_ref_hz_ * st.chain.t_s, 1.0);
-    ref_offset_[2] = ref_offset_[1];
-    ref_offset_[1] = ref_offset_[0];
+    for (std::size_t i = kHistory - 1; i > 0; --i) {
+      ref_offset_[i] = ref_offset_[i - 1];
+      truth_[i] = truth_[i - 1];
+    }
     ref_offset_[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
-    truth_[2] = truth_[1];
-    truth_[1] = truth_[0];
     truth_[0] = target.true_state();
+    ++blocks_;
   }
 
-  // The decimating filter's output is centred 1.5 L - 1 samples before the
-  // block's last sample, i.e. 1.5 blocks before t_s: half-way between the
-  // states one and two blocks back. Stamped at the block end instead, a rate
-  // ramp of 10 deg/s^2 puts a 0.015 deg/s error into the input rate the
-  // envelope saw, which the audit takes for a pickoff gain mismatch.
-  sim::TrueState truth() const { return midpoint(truth_[1], truth_[2]); }
+  // Rows start once the history is full.
+  bool history_full() const { return blocks_ >= kHistory; }
+  // Stamped at the block end instead of the filter's centre, a rate ramp of
+  // 10 deg/s^2 puts a 0.015 deg/s error (sinc^3 figure) into the input rate
+  // the envelope saw, which the audit takes for a pickoff gain mismatch.
+  sim::TrueState truth() const { return midpoint(truth_[kCentre], truth_[kCentre + 1]); }
   double ref_offset_rad() const {
-    return ref_offset_[1] + 0.5 * std::remainder(ref_offset_[2] - ref_offset_[1], 2.0 * kPi);
+    return ref_offset_[kCentre] +
+           0.5 * std::remainder(ref_offset_[kCentre + 1] - ref_offset_[kCentre], 2.0 * kPi);
   }
   bool drive_free() const { return off_blocks_ >= drive_free_blocks_; }
 
@@ -178,8 +189,9 @@ class RowStamper {
   double f_ref_hz_;
   uint64_t drive_free_blocks_ = 0;
   uint64_t off_blocks_ = 0;  // blocks since the excitation was last on
-  double ref_offset_[3] = {0.0, 0.0, 0.0};
-  sim::TrueState truth_[3];
+  uint64_t blocks_ = 0;
+  double ref_offset_[kHistory] = {};
+  sim::TrueState truth_[kHistory];
 };
 
 // Angles are compared from the first valid output on.
@@ -325,7 +337,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     stamp.after_block(*firmware, target);
     track_events(gyro, target, last_mode, r);
     drain_can(target, log.get(), st.chain.t_s, r);
-    if (k % row_every != 0 || k < 2) continue;  // rows from a full history on
+    if (k % row_every != 0 || !stamp.history_full()) continue;
     if (!ref.set && st.out_valid) {
       ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};
     }
