@@ -132,8 +132,7 @@ class SimTarget {
   // buffers (nothing is allocated while running).
   static constexpr std::size_t kChunk = 128;
 
-  hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
-                            uint32_t& clipped);
+  hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped);
   void run_resonator(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   uint32_t quantize(std::size_t n, hal::q31_t* out);

@@ -229,7 +229,7 @@ const std::vector<std::string>& telemetry_columns() {
 }
 
 // One row's values in telemetry_columns() order.
-void telemetry_values(const Row& row, std::vector<double>& v) {
+void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
   v = {row.t_s,
        row.cx_v,
        row.sx_v,
@@ -270,7 +270,7 @@ void write_telemetry(const std::filesystem::path& path, const JobConfig& job, co
   recording::RecordingWriter wr(path, telemetry_columns(), job.firmware.chain.f_center_hz,
                                 job.firmware.gyro.angular_gain, telemetry_metadata(job));
   std::vector<double> v;
-  for (const Row& row : r.rows) {
+  for (const TelemetryRow& row : r.rows) {
     telemetry_values(row, v);
     wr.write_row(v);
   }
@@ -283,7 +283,7 @@ recording::Recording telemetry_recording(const JobConfig& job, const JobResult& 
   for (const auto& [key, value] : telemetry_metadata(job))
     rec.set_metadata(key, value);
   std::vector<double> v;
-  for (const Row& row : r.rows) {
+  for (const TelemetryRow& row : r.rows) {
     telemetry_values(row, v);
     rec.append_row(v);
   }
