@@ -12,6 +12,7 @@
 
 #include "audit/plots.hpp"
 #include "dataset.hpp"
+#include "description.hpp"
 #include "dsp/wave_variables.hpp"
 #include "fit.hpp"
 #include "model.hpp"
@@ -52,11 +53,20 @@ struct State {
   bool feedthrough = false;
 };
 
+Mask with_term(Mask m, const GenericTerm& t) {
+  for (int i : t.params())
+    m[static_cast<std::size_t>(i)] = true;
+  return m;
+}
+
 // Effects taken by the forward selection, in the order they were taken.
 struct Chosen {
   Effect effect;
   double dbic = 0.0;
   double dchi = 0.0;  // chi^2 removed by it when it was added
+  // Set by weigh_findings(): value, 1-sigma (catalogue unit) and the share of
+  // the baseline's misfit it removes given everything else (-1: edges).
+  double value = 0.0, sigma = 0.0, fraction = 0.0;
 };
 
 // One candidate added to the current model.
@@ -77,7 +87,7 @@ class Auditor {
  private:
   double n_free_res() const { return 4.0 * static_cast<double>(n_blocks_fit_); }
   bool testable(Effect e) const;
-  State fit_state(const Mask& mask, const Params& start, bool feedthrough);
+  State fit_state(const Mask& mask, const Params& start, bool feedthrough, int max_iterations = 30);
   double ln_neff(const State& s) const {
     return std::log(std::max(10.0, s.kappa * static_cast<double>(s.fit.n_res)));
   }
@@ -88,6 +98,7 @@ class Auditor {
   }
   double heldout_rms(const Mask& mask, const Params& start);
   double rms_v(const State& s) const;
+  double slow_noise_factor(const State& s) const;
 
   // Steps of run(), in order.
   Params start_params() const;
@@ -102,12 +113,13 @@ class Auditor {
   std::vector<Chosen> forward_select(State& cur, AuditResult& out);
   void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
                         AuditResult& out);
+  State describe(const State& cat, AuditResult& out);
+  void weigh_findings(const State& baseline, const State& full, const FeedStat& ft,
+                      std::vector<Chosen>& chosen, bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
-  bool claim_findings(const State& baseline, const State& cur, const FeedStat& ft,
-                      const std::vector<Chosen>& chosen, AuditResult& out);
+  void claim_findings(const State& cur, const std::vector<Chosen>& chosen, AuditResult& out);
   void report_locations(const State& baseline, const FeedStat& ft, AuditResult& out);
-  void set_verdict(const State& cur, const FeedStat& ft, bool structure_left, bool any_chosen,
-                   AuditResult& out);
+  void set_verdict(const State& cur, const FeedStat& ft, bool structure_left, AuditResult& out);
 
   AuditOptions opt_;
   Dataset d_;
@@ -126,11 +138,12 @@ bool Auditor::testable(Effect e) const {
   }
 }
 
-State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough) {
+State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough,
+                         int max_iterations) {
   State s;
   s.mask = mask;
   s.feedthrough = feedthrough;
-  s.fit = fit(d_, start, mask, eo_);
+  s.fit = fit(d_, start, mask, eo_, max_iterations);
   evaluate(d_, s.fit.p, eo_, s.res);
   s.kappa = effective_fraction(s.res, static_cast<std::size_t>(n_free_res()));
   return s;
@@ -158,6 +171,37 @@ double Auditor::rms_v(const State& s) const {
   for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
     acc += s.res[i] * s.res[i];
   return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
+}
+
+// Variance of the block residuals at long lags over the white level: half
+// the mean square of their first differences at stride m within segments,
+// for m doubling up to 64 blocks while it grows by less than 2x per doubling.
+// White noise stays at 1, 1/f-like noise grows slowly (about logarithmically),
+// and a smooth structure grows 4x per doubling and stops the search, so it
+// is not taken for noise.
+double Auditor::slow_noise_factor(const State& s) const {
+  auto half_d = [&](std::size_t m) {
+    double acc = 0.0, cnt = 0.0;
+    std::size_t k0 = 0;
+    for (const auto& seg : d_.free) {
+      for (std::size_t b = m; b < seg.n_blocks; ++b) {
+        const std::size_t k = k0 + 4 * b;
+        for (std::size_t c = 0; c < 4; ++c) {
+          const double d1 = s.res[k + c] - s.res[k - 4 * m + c];
+          acc += d1 * d1, cnt += 2.0;
+        }
+      }
+      k0 += 4 * seg.n_blocks;
+    }
+    return cnt > 100.0 ? acc / cnt : -1.0;
+  };
+  double level = std::max(1.0, half_d(1));
+  for (std::size_t m = 2; m <= 64; m *= 2) {
+    const double next = half_d(m);
+    if (next < 0.0 || next > 2.0 * level) break;
+    level = std::max(level, next);
+  }
+  return level;
 }
 
 // Start values: decay rate from the energy of each free segment.
@@ -197,7 +241,20 @@ Mask Auditor::baseline_mask() const {
 // join with their scatter as weight.
 State Auditor::fit_baseline(AuditResult& out) {
   const Mask base = baseline_mask();
-  State cur = fit_state(base, start_params(), false);
+  // Several starts of the damping anisotropy (dmu 0.05 in four directions of
+  // 4 th_mu): a baseline caught in a local minimum would be the start of
+  // every candidate after it.
+  const Params p0 = start_params();
+  // The starts are compared after a few iterations; the best is refined.
+  State cur = fit_state(base, p0, false, 4);
+  for (int k = 0; k < 4; ++k) {
+    Params q = p0;
+    q[kDnuC] = 0.05 * p0[kNu] * std::cos(0.5 * kPi * k);
+    q[kDnuS] = 0.05 * p0[kNu] * std::sin(0.5 * kPi * k);
+    State s = fit_state(base, q, false, 4);
+    if (s.fit.chi2 < cur.fit.chi2 - 1e-6 * cur.fit.chi2) cur = std::move(s);
+  }
+  cur = fit_state(base, cur.fit.p, false);
   cur = adopt_block_noise(base, cur, out);
   if (d_.forced.size() >= 3) cur = weight_forced_segments(base, cur);
   if (std::getenv("HRG_AUDIT_DEBUG")) {
@@ -415,37 +472,127 @@ void Auditor::report_baseline(const State& baseline, const State& cur, bool any_
   out.heldout_rms_final_v = any_chosen ? heldout_rms(cur.mask, cur.fit.p) : out.heldout_rms_v;
 }
 
-// With structure left that no candidate takes up, a candidate that only
-// nibbles at it is not a finding: only effects that explain a real share of
-// the baseline's misfit are claimed, the rest are listed as alternatives.
-// Returns whether structure is left after the selected model.
-bool Auditor::claim_findings(const State& baseline, const State& cur, const FeedStat& ft,
-                             const std::vector<Chosen>& chosen, AuditResult& out) {
-  const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
-  const bool structure_left = ratio > opt_.unexplained_ratio;
-  const double excess0 = baseline.fit.chi2 - static_cast<double>(baseline.fit.n_res);
-  for (const auto& c : chosen) {
-    const auto pi = param_of(c.effect);
-    if (structure_left &&
-        (c.effect == Effect::drive_feedthrough || c.dchi < 0.2 * std::max(excess0, 1.0))) {
-      const double v = pi < 0 ? std::max(ft.c_x, ft.c_y)
-                              : to_catalogue(c.effect, cur.fit.p[static_cast<std::size_t>(pi)]);
-      out.alternatives.push_back({c.effect, v, c.dbic,
-                                  "takes up only part of structure that stays unexplained; "
-                                  "not claimed"});
+// Generic description of what the catalogue model leaves: forward selection
+// over the generic terms on top of it (stricter evidence: a search over many
+// shapes), refitted by output error with everything else. A term is taken
+// only when it also reproduces on the held-out segments (their mean-square
+// residual falls by at least a quarter of what it falls on the fitted ones):
+// slow coloured noise fits a term on the data it sees, not on the rest) and
+// when it is material: it lowers the mean-square residual by at least
+// min_description_share of the noise variance, its slow part included (the
+// slowest octaves of 1/f noise are offsets and drifts over a recording).
+// Returns the model with the description (the catalogue model when nothing
+// is accepted).
+State Auditor::describe(const State& cat, AuditResult& out) {
+  State cur = cat;
+  std::vector<const GenericTerm*> taken;
+  const double excess0 = std::max(1.0, cat.fit.chi2 - static_cast<double>(cat.fit.n_res));
+  double heldout_cur = -1.0;
+  const double slow = slow_noise_factor(cat);
+  for (int step = 0; step < opt_.max_description_terms; ++step) {
+    const GenericTerm* best = nullptr;
+    double best_dbic = -1e300;
+    for (const auto& t : generic_terms()) {
+      if (std::find(taken.begin(), taken.end(), &t) != taken.end()) continue;
+      if (t.needs_temp && !(d_.has_temp && d_.temp_span_c > 0.02)) continue;
+      if (t.needs_forced && !eo_.use_forced) continue;
+      // Scored after a few iterations (the terms enter nearly linearly).
+      const State s = fit_state(with_term(cur.mask, t), cur.fit.p, cur.feedthrough, 2);
+      const double dbic = delta_bic(cur, s, t.n_params);
+      if (dbic > best_dbic) best_dbic = dbic, best = &t;
+    }
+    if (best == nullptr || best_dbic < opt_.min_description_bic) break;
+    State next = fit_state(with_term(cur.mask, *best), cur.fit.p, cur.feedthrough);
+    const double dbic = delta_bic(cur, next, best->n_params);
+    if (dbic < opt_.min_description_bic) break;
+    if (heldout_cur < 0.0) heldout_cur = heldout_rms(cur.mask, cur.fit.p);
+    const double heldout_next = heldout_rms(next.mask, next.fit.p);
+    const double fitted_fall = rms_v(cur) * rms_v(cur) - rms_v(next) * rms_v(next);
+    const double heldout_fall = heldout_cur * heldout_cur - heldout_next * heldout_next;
+    if (!(heldout_fall > 0.25 * fitted_fall)) break;
+    if (fitted_fall < opt_.min_description_share * slow * d_.noise_v * d_.noise_v) break;
+    out.description.terms.push_back({best->id, "", dbic, (cur.fit.chi2 - next.fit.chi2) / excess0});
+    taken.push_back(best);
+    heldout_cur = heldout_next;
+    cur = std::move(next);
+  }
+  if (taken.empty()) return cat;
+  Params sigma{};
+  for (int i = 0; i < kParamCount; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    sigma[k] = cur.fit.sigma[k] / std::sqrt(cur.kappa);
+  }
+  for (std::size_t i = 0; i < taken.size(); ++i)
+    out.description.terms[i].text = describe_term(*taken[i], d_, cur.fit.p, sigma);
+  out.description.fit_rms_before_v = rms_v(cat);
+  out.description.fit_rms_after_v = rms_v(cur);
+  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
+  out.description.heldout_rms_after_v = heldout_cur;
+  return cur;
+}
+
+// A finding must carry its own weight. Each chosen effect is refitted out of
+// the final model (everything else accepted, the description too): it stays
+// a finding only when it is still needed there (delta BIC), stands
+// min_significance of its standard deviations away from zero and, with
+// structure left, removes at least min_explains_fraction of the baseline's
+// misfit beyond the noise; otherwise it is an alternative.
+void Auditor::weigh_findings(const State& baseline, const State& full, const FeedStat& ft,
+                             std::vector<Chosen>& chosen, bool structure_left, AuditResult& out) {
+  const double excess0 = std::max(1.0, baseline.fit.chi2 - static_cast<double>(baseline.fit.n_res));
+  std::vector<Chosen> kept;
+  for (auto& c : chosen) {
+    const int pi = param_of(c.effect);
+    const char* why = nullptr;
+    double value = std::max(ft.c_x, ft.c_y), sigma = ft.sigma;
+    c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
+    if (pi >= 0) {
+      const auto i = static_cast<std::size_t>(pi);
+      value = to_catalogue(c.effect, full.fit.p[i]);
+      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i])) / std::sqrt(full.kappa);
+      double unique_dbic = c.dbic;
+      if (chosen.size() > 1 || !out.description.terms.empty()) {
+        Mask m = full.mask;
+        m[i] = false;
+        Params q = full.fit.p;
+        q[i] = 0.0;
+        const State without = fit_state(m, q, false);
+        unique_dbic = delta_bic(without, full, 1);
+        c.fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
+      } else {
+        c.fraction = std::max(0.0, c.dchi) / excess0;
+      }
+      if (unique_dbic < opt_.min_delta_bic) {
+        why = "not needed once the other accepted effects and the description are in";
+      }
+    }
+    if (why == nullptr && !(std::abs(value) >= opt_.min_significance * sigma)) {
+      why = "not significantly away from zero";
+    } else if (why == nullptr && structure_left &&
+               (pi < 0 || c.fraction < opt_.min_explains_fraction)) {
+      why = "takes up only part of structure that stays unexplained; not claimed";
+    }
+    if (why != nullptr) {
+      out.alternatives.push_back({c.effect, value, c.dbic, why});
       continue;
     }
+    c.value = value, c.sigma = sigma;
+    kept.push_back(c);
+  }
+  chosen.swap(kept);
+}
+
+// The findings that carried their weight, strongest first.
+void Auditor::claim_findings(const State& cur, const std::vector<Chosen>& chosen,
+                             AuditResult& out) {
+  for (const auto& c : chosen) {
     Finding f;
     f.effect = c.effect;
     f.delta_bic = c.dbic;
-    if (pi < 0) {
-      f.value = std::max(ft.c_x, ft.c_y);
-      f.sigma = ft.sigma;
-    } else {
-      const auto i = static_cast<std::size_t>(pi);
-      f.value = to_catalogue(c.effect, cur.fit.p[i]);
-      f.sigma = to_catalogue(c.effect, cur.fit.sigma[i]) / std::sqrt(cur.kappa);
-    }
+    f.value = c.value;
+    f.sigma = c.sigma;
+    f.significance = c.sigma > 0.0 ? std::abs(c.value) / c.sigma : 0.0;
+    f.explains_fraction = c.fraction;
     f.heldout_rms_before_v = out.heldout_rms_v;
     f.heldout_rms_after_v = out.heldout_rms_final_v;
     f.impact = impact_text(d_, cur.fit.p, c.effect, f.value);
@@ -453,7 +600,6 @@ bool Auditor::claim_findings(const State& baseline, const State& cur, const Feed
   }
   std::sort(out.findings.begin(), out.findings.end(),
             [](const Finding& a, const Finding& b) { return a.delta_bic > b.delta_bic; });
-  return structure_left;
 }
 
 // Where the baseline misfits (strongest eight), and where each candidate sees
@@ -467,18 +613,24 @@ void Auditor::report_locations(const State& baseline, const FeedStat& ft, AuditR
 }
 
 void Auditor::set_verdict(const State& cur, const FeedStat& ft, bool structure_left,
-                          bool any_chosen, AuditResult& out) {
-  if (structure_left) {
-    const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+                          AuditResult& out) {
+  if (!out.description.terms.empty()) {
+    out.unexplained_note = "structure the catalogue cannot name, described as: ";
+    for (std::size_t i = 0; i < out.description.terms.size(); ++i)
+      out.unexplained_note += (i ? "; " : "") + out.description.terms[i].text;
+    out.verdict = "unexplained";
+  } else if (structure_left) {
+    const double ratio =
+        cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res)) / slow_noise_factor(cur);
     const auto left = locate(d_, cur.fit.p, cur.res, eo_.use_forced, ft);
     char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "residual variance %.2f x the white-noise level after the best model", ratio);
+    std::snprintf(buf, sizeof buf, "residual variance %.2f x the noise level after the best model",
+                  ratio);
     out.unexplained_note = buf;
     if (!left.empty())
       out.unexplained_note += "; largest at " + left.front().signal + ", " + left.front().where;
     out.verdict = "unexplained";
-  } else if (!any_chosen) {
+  } else if (out.findings.empty()) {
     out.verdict = "consistent";
   } else if (!out.ambiguity_experiment.empty()) {
     out.verdict = "ambiguous";
@@ -499,11 +651,31 @@ AuditResult Auditor::run(PlotData* plot) {
   // The switching edges against the final free-decay model.
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   test_feedthrough(cur, ft, chosen, out);
-  report_baseline(baseline, cur, !chosen.empty(), out);
-  const bool structure_left = claim_findings(baseline, cur, ft, chosen, out);
+  // The description is looked for when something was chosen (its weight is
+  // then tested against it) or the residual is above the white noise at all;
+  // a recording at the noise has nothing to describe.
+  const double ratio0 = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  const State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  // Structure is left when the description found some, or when the residual
+  // stays above the noise including its slow (coloured) part.
+  const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));
+  const double slow = slow_noise_factor(full);
+  if (slow > 1.2) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "slow (coloured) noise: the residual's variance at lags of up to 64 blocks is "
+                  "%.2f x its white level, used as the noise of the structure test",
+                  slow);
+    out.notes.push_back(buf);
+  }
+  const bool structure_left =
+      ratio / slow > opt_.unexplained_ratio || !out.description.terms.empty();
+  weigh_findings(baseline, full, ft, chosen, structure_left, out);
+  report_baseline(baseline, full, !chosen.empty() || !out.description.terms.empty(), out);
+  claim_findings(full, chosen, out);
   report_locations(baseline, ft, out);
-  set_verdict(cur, ft, structure_left, !chosen.empty(), out);
-  if (plot) fill_plot(d_, eo_, baseline.fit.p, cur.fit.p, *plot);
+  set_verdict(full, ft, structure_left, out);
+  if (plot) fill_plot(d_, eo_, baseline.fit.p, full.fit.p, *plot);
   return out;
 }
 

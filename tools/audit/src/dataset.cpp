@@ -278,6 +278,7 @@ Block make_block(const Rows& r, const Dataset& d, std::size_t b0, std::size_t b1
     b.rate_rad_s += r.rate_rad_s(i) / b.n;
     b.a2_v2 += r.a2[i] / b.n;
     b.theta_rad += r.theta[i] / b.n;
+    b.rot += std::polar(1.0, d.frame_phase_rad[i]) / b.n;
   }
   return b;
 }
@@ -338,6 +339,7 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
   d.has_temp = r.temp != nullptr;
   d.has_rate = r.rate != nullptr;
   d.t_s = r.t;
+  if (r.n > 0) d.t_mid_s = 0.5 * (r.t.front() + r.t.back());
   const std::vector<Run> runs = cut_runs(r);
   note_gaps(rec, d);
   wave_rows(r);

@@ -63,7 +63,8 @@ std::string finding_json(const Finding& f) {
          str(info.param) + ": " + num(f.sigma) + "}, \"delta_bic\": " + num(f.delta_bic) +
          ", \"heldout_rms_before\": " + num(f.heldout_rms_before_v) +
          ", \"heldout_rms_after\": " + num(f.heldout_rms_after_v) +
-         ", \"impact\": " + str(f.impact) + "}";
+         ", \"explains_fraction\": " + num(f.explains_fraction < 0.0 ? NAN : f.explains_fraction) +
+         ", \"significance\": " + num(f.significance) + ", \"impact\": " + str(f.impact) + "}";
 }
 
 std::string alternative_json(const Alternative& a) {
@@ -71,6 +72,22 @@ std::string alternative_json(const Alternative& a) {
   return "{\"effect\": " + str(info.id) + ", \"params\": {" + str(info.param) + ": " +
          num(a.value) + "}, \"delta_bic\": " + num(a.delta_bic) + ", \"note\": " + str(a.note) +
          "}";
+}
+
+std::string term_json(const DescriptionTerm& t) {
+  return "{\"term\": " + str(t.term) + ", \"text\": " + str(t.text) +
+         ", \"delta_bic\": " + num(t.delta_bic) +
+         ", \"explains_fraction\": " + num(t.explains_fraction) + "}";
+}
+
+// The description of what the catalogue cannot name, with the fit before and
+// after it (never a catalogue name, never written into a calibration).
+std::string description_json(const Description& d) {
+  return "{\"terms\": " + json_list(d.terms, term_json) +
+         ", \"fit_rms_before\": " + num(d.fit_rms_before_v) +
+         ", \"fit_rms_after\": " + num(d.fit_rms_after_v) +
+         ", \"heldout_rms_before\": " + num(d.heldout_rms_before_v) +
+         ", \"heldout_rms_after\": " + num(d.heldout_rms_after_v) + "}";
 }
 
 std::string candidate_json(const CandidateScore& c) {
@@ -92,6 +109,7 @@ std::string to_json(const AuditResult& r) {
     j += ",\n  \"separating_experiment\": " + str(r.ambiguity_experiment);
   }
   if (!r.unexplained_note.empty()) j += ",\n  \"unexplained\": " + str(r.unexplained_note);
+  if (!r.description.terms.empty()) j += ",\n  \"description\": " + description_json(r.description);
   j += ",\n  \"candidates\": " + json_list(r.candidates, candidate_json);
   j += ",\n  \"notes\": [";
   for (std::size_t i = 0; i < r.notes.size(); ++i)
@@ -115,6 +133,13 @@ std::string to_text(const AuditResult& r, const std::string& source) {
     std::snprintf(buf, sizeof buf, "  FOUND %s: %s = %.4g +/- %.2g %s (delta BIC %.1f)\n", info.id,
                   info.param, f.value, f.sigma, info.unit, f.delta_bic);
     t += buf;
+    if (f.explains_fraction >= 0.0) {
+      std::snprintf(buf, sizeof buf,
+                    "    weight:  removes %.0f %% of the baseline's misfit beyond the noise, "
+                    "%.1f sigma from zero\n",
+                    100.0 * f.explains_fraction, f.significance);
+      t += buf;
+    }
     t += "    physics: " + std::string(info.explanation) + "\n";
     t += "    impact:  " + f.impact + "\n";
   }
@@ -127,7 +152,18 @@ std::string to_text(const AuditResult& r, const std::string& source) {
                   a.note.c_str());
     t += buf;
   }
-  if (!r.unexplained_note.empty()) t += "  UNEXPLAINED: " + r.unexplained_note + "\n";
+  if (!r.description.terms.empty()) {
+    t += "  UNEXPLAINED, described (not a catalogue effect; never a calibration):\n";
+    for (const auto& d : r.description.terms)
+      t += "    - " + d.text + "\n";
+    std::snprintf(buf, sizeof buf,
+                  "    fit: %.3g V -> %.3g V; held-out segments %.3g V -> %.3g V (noise %.3g V)\n",
+                  r.description.fit_rms_before_v, r.description.fit_rms_after_v,
+                  r.description.heldout_rms_before_v, r.description.heldout_rms_after_v, r.noise_v);
+    t += buf;
+  } else if (!r.unexplained_note.empty()) {
+    t += "  UNEXPLAINED: " + r.unexplained_note + "\n";
+  }
   t += "\nWhere the baseline misfits:\n";
   if (r.locations.empty()) t += "  nowhere above 5 sigma\n";
   for (const auto& l : r.locations) {

@@ -266,15 +266,33 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
 }
 
 double effective_fraction(const std::vector<double>& res, std::size_t n_free_res) {
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i + 4 < n_free_res; ++i)
-    num += res[i] * res[i + 4];
+  // Integrated autocorrelation time of the block residuals (lags in blocks,
+  // 4 residuals per block), summed over pairs of lags while the pair sum stays
+  // positive: slow coloured noise (1/f-like) keeps the correlation up over
+  // many blocks, and its samples count for less than white ones. For an AR(1)
+  // residual this is (1 - rho)/(1 + rho).
+  n_free_res = std::min(n_free_res, res.size());
+  double den = 0.0;
   for (std::size_t i = 0; i < n_free_res; ++i)
     den += res[i] * res[i];
   if (den <= 0.0) return 1.0;
-  const double rho = num / den;
-  if (rho <= 0.0) return 1.0;
-  return std::clamp((1.0 - rho) / (1.0 + rho), 0.02, 1.0);
+  auto rho = [&](std::size_t lag) {
+    double num = 0.0;
+    for (std::size_t i = 0; i + 4 * lag < n_free_res; ++i)
+      num += res[i] * res[i + 4 * lag];
+    return num / den;
+  };
+  const std::size_t max_lag = std::min<std::size_t>(64, n_free_res / 40);
+  double tau = 1.0;
+  const double r1 = rho(1);
+  if (r1 <= 0.0) return 1.0;
+  tau += 2.0 * r1;
+  for (std::size_t lag = 2; lag + 1 <= max_lag; lag += 2) {
+    const double pair = rho(lag) + rho(lag + 1);
+    if (pair <= 0.0) break;
+    tau += 2.0 * pair;
+  }
+  return std::clamp(1.0 / tau, 0.02, 1.0);
 }
 
 namespace {
