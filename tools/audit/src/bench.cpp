@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <numbers>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -14,6 +15,7 @@ namespace hrg::audit {
 
 namespace {
 
+constexpr double kPi = std::numbers::pi;
 using bench::Design;
 using bench::kOutsideEffectCount;
 using bench::outside_name;
@@ -137,15 +139,27 @@ BenchCase multi_case(const Scenario& base, const AuditResult& null_r, int count,
   return c;
 }
 
-// One effect outside the catalogue, well above the noise: a drift of the y/x
-// gain ratio or of the y phase over the recording, an offset on the x
-// pickoff, or a y gain that follows the temperature.
-BenchCase outside_case(const Scenario& base, std::mt19937_64& g, const AuditFn& audit) {
+double threshold_of(const AuditResult& r, Effect e) {
+  for (const auto& c : r.candidates) {
+    if (c.effect == e && c.testable && std::isfinite(c.threshold)) return c.threshold;
+  }
+  return 0.0;
+}
+
+// One effect outside the catalogue, well above what the design can detect: a
+// drift of the y/x gain ratio or of the y phase over the recording, or a y
+// gain that follows the temperature, changing by 6x-12x the detection
+// threshold of the constant pickoff gain (phase) mismatch over the recording
+// (the temperature swing), or an offset of 5-20x the noise on the x pickoff.
+BenchCase outside_case(const Scenario& base, const AuditResult& null_r, std::mt19937_64& g,
+                       const AuditFn& audit) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   Scenario s = base;
   s.outside = static_cast<OutsideEffect>(1 + static_cast<int>(u(g) * kOutsideEffectCount));
-  const double rel = base.noise_v / base.amplitude_v;
-  const double total = (30.0 + 70.0 * u(g)) * rel * (u(g) < 0.5 ? -1.0 : 1.0);
+  const double th = s.outside == OutsideEffect::phase_drift
+                        ? threshold_of(null_r, Effect::pickoff_phase_mismatch) * kPi / 180.0
+                        : threshold_of(null_r, Effect::pickoff_gain_mismatch);
+  const double total = (6.0 + 6.0 * u(g)) * th * (u(g) < 0.5 ? -1.0 : 1.0);
   switch (s.outside) {
     case OutsideEffect::gain_ratio_drift:
     case OutsideEffect::phase_drift: s.outside_value = total / (s.duration_s / 3600.0); break;
@@ -215,7 +229,7 @@ void run_extra_cases(const Scenario& base, const AuditResult& null_r, int d, uin
     c.design = d, c.campaign = base.design, c.pll_reference = base.pll_reference;
     res.cases.push_back(c);
   }
-  BenchCase c = outside_case(base, g, audit);
+  BenchCase c = outside_case(base, null_r, g, audit);
   ++res.outside;
   if (c.described) ++res.outside_described;
   if (c.description_matches) ++res.outside_matched;

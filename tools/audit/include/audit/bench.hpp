@@ -10,7 +10,9 @@
 
 // The proof of `hrg audit`: recordings from sim_target with one catalogue
 // effect concealed at a random sign and a strength of 0.3x-3x its detection
-// threshold, and null recordings, in ring-down and telemetry campaigns.
+// threshold, and null recordings, in ring-down and telemetry campaigns; per
+// design also a null with 1/f noise, two and three effects at once and one
+// effect outside the catalogue.
 namespace hrg::audit {
 
 namespace bench {
