@@ -89,6 +89,12 @@ int top_of(const AuditResult& r, double& value) {
   return static_cast<int>(r.findings.front().effect);
 }
 
+std::string fmt_g(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
 using AuditFn = std::function<std::pair<AuditResult, double>(const recording::Recording&)>;
 
 // The damping may change by at most half over the campaign's amplitude or
@@ -132,6 +138,7 @@ BenchCase multi_case(const Scenario& base, const AuditResult& null_r, int count,
     const auto it = std::find_if(r.findings.begin(), r.findings.end(), [&](const Finding& f) {
       return static_cast<int>(f.effect) == c.truths[k];
     });
+    c.found_values.push_back(it == r.findings.end() ? std::nan("") : it->value);
     if (it == r.findings.end() ||
         std::abs(it->value - c.true_values[k]) > 0.2 * std::abs(c.true_values[k]))
       c.all_found = false;
@@ -222,7 +229,8 @@ void run_extra_cases(const Scenario& base, const AuditResult& null_r, int d, uin
     if (verbose) {
       std::string what;
       for (std::size_t k = 0; k < c.truths.size(); ++k)
-        what += std::string(k ? " + " : "") + effect_info(static_cast<Effect>(c.truths[k])).id;
+        what += std::string(k ? " + " : "") + effect_info(static_cast<Effect>(c.truths[k])).id +
+                " " + fmt_g(c.true_values[k]) + " (" + fmt_g(c.found_values[k]) + ")";
       std::fprintf(stderr, "  %s -> %s, %d findings%s\n", what.c_str(), c.verdict.c_str(),
                    c.findings, c.all_found ? "" : "   <-- MISS");
     }

@@ -137,9 +137,12 @@ bool outside_by_name(const std::string& name, OutsideEffect& e) {
 void apply_outside_effects(const Scenario& s, recording::Recording& rec) {
   if (rec.rows() == 0) return;
   std::mt19937_64 g(s.seed * 2862933555777941757ULL + 7ULL);
+  // The reference first: offsets and the lock-in's 1/f noise come after the
+  // mixing, in the frame of the reference the demodulator used (a pickoff
+  // gain or phase commutes with it).
+  if (s.pll_reference) follow_resonance(s, rec, g);
   if (s.outside != OutsideEffect::none) add_outside(s, rec, g);
   if (s.flicker_corner_hz > 0.0) add_flicker(s, rec, g);
-  if (s.pll_reference) follow_resonance(s, rec, g);
 }
 
 }  // namespace hrg::audit::bench

@@ -54,6 +54,7 @@ struct BenchCase {
   // finding with its parameter within 20 %.
   std::vector<int> truths;
   std::vector<double> true_values;
+  std::vector<double> found_values;  // NaN where the effect is not a finding
   bool all_found = false;
   int findings = 0;  // catalogue findings of the audit
   // Outside the catalogue: the audit describes it (verdict unexplained, a
