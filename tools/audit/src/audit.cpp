@@ -67,6 +67,7 @@ struct Chosen {
   // Set by weigh_findings(): value, 1-sigma (catalogue unit) and the share of
   // the baseline's misfit it removes given everything else (-1: edges).
   double value = 0.0, sigma = 0.0, fraction = 0.0;
+  bool unique_checked = false;  // fraction from a drop-one refit
 };
 
 // One candidate added to the current model.
@@ -114,8 +115,9 @@ class Auditor {
   void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
                         AuditResult& out);
   State describe(const State& cat, AuditResult& out);
-  void weigh_findings(const State& baseline, const State& full, const FeedStat& ft,
-                      std::vector<Chosen>& chosen, bool structure_left, AuditResult& out);
+  State drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out);
+  void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
+                      bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
   void claim_findings(const State& cur, const std::vector<Chosen>& chosen, AuditResult& out);
   void report_locations(const State& baseline, const FeedStat& ft, AuditResult& out);
@@ -125,6 +127,7 @@ class Auditor {
   Dataset d_;
   EvalOptions eo_;
   std::size_t n_blocks_fit_ = 0;
+  double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
 };
 
 bool Auditor::testable(Effect e) const {
@@ -531,45 +534,68 @@ State Auditor::describe(const State& cat, AuditResult& out) {
   return cur;
 }
 
-// A finding must carry its own weight. Each chosen effect is refitted out of
-// the final model (everything else accepted, the description too): it stays
-// a finding only when it is still needed there (delta BIC), stands
+// Backward elimination over the chosen catalogue effects: each is refitted
+// out of the model (every other accepted effect and the description in); the
+// weakest whose delta BIC there is below the acceptance level leaves it (an
+// alternative: what it explained, the others explain as well) and the model
+// is refitted without it, until every remaining one is needed. One at a time,
+// so that two effects that can stand for each other do not both leave.
+State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out) {
+  if (chosen.size() < 2 && out.description.terms.empty()) return full;
+  const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+  for (;;) {
+    std::size_t worst = chosen.size();
+    double worst_dbic = 1e300;
+    State worst_without;
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const int pi = param_of(chosen[k].effect);
+      if (pi < 0) continue;
+      const auto i = static_cast<std::size_t>(pi);
+      Mask m = full.mask;
+      m[i] = false;
+      Params q = full.fit.p;
+      q[i] = 0.0;
+      State without = fit_state(m, q, false);
+      const double unique_dbic = delta_bic(without, full, 1);
+      chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
+      chosen[k].unique_checked = true;
+      if (unique_dbic < worst_dbic)
+        worst_dbic = unique_dbic, worst = k, worst_without = std::move(without);
+    }
+    if (worst == chosen.size() || worst_dbic >= opt_.min_delta_bic) return full;
+    const Chosen& c = chosen[worst];
+    out.alternatives.push_back(
+        {c.effect, to_catalogue(c.effect, full.fit.p[static_cast<std::size_t>(param_of(c.effect))]),
+         c.dbic, "not needed once the other accepted effects and the description are in"});
+    chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
+    full = std::move(worst_without);
+  }
+}
+
+// A finding must carry its own weight: after drop_unneeded() it must stand
 // min_significance of its standard deviations away from zero and, with
-// structure left, removes at least min_explains_fraction of the baseline's
-// misfit beyond the noise; otherwise it is an alternative.
-void Auditor::weigh_findings(const State& baseline, const State& full, const FeedStat& ft,
-                             std::vector<Chosen>& chosen, bool structure_left, AuditResult& out) {
-  const double excess0 = std::max(1.0, baseline.fit.chi2 - static_cast<double>(baseline.fit.n_res));
+// structure left, remove at least min_explains_fraction of the baseline's
+// misfit beyond the noise (given everything else); otherwise it is an
+// alternative.
+void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
+                             bool structure_left, AuditResult& out) {
+  const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
   std::vector<Chosen> kept;
   for (auto& c : chosen) {
     const int pi = param_of(c.effect);
     const char* why = nullptr;
     double value = std::max(ft.c_x, ft.c_y), sigma = ft.sigma;
-    c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
     if (pi >= 0) {
       const auto i = static_cast<std::size_t>(pi);
       value = to_catalogue(c.effect, full.fit.p[i]);
       sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i])) / std::sqrt(full.kappa);
-      double unique_dbic = c.dbic;
-      if (chosen.size() > 1 || !out.description.terms.empty()) {
-        Mask m = full.mask;
-        m[i] = false;
-        Params q = full.fit.p;
-        q[i] = 0.0;
-        const State without = fit_state(m, q, false);
-        unique_dbic = delta_bic(without, full, 1);
-        c.fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
-      } else {
-        c.fraction = std::max(0.0, c.dchi) / excess0;
-      }
-      if (unique_dbic < opt_.min_delta_bic) {
-        why = "not needed once the other accepted effects and the description are in";
-      }
+      if (!c.unique_checked) c.fraction = std::max(0.0, c.dchi) / excess0;
+    } else {
+      c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
     }
-    if (why == nullptr && !(std::abs(value) >= opt_.min_significance * sigma)) {
+    if (!(std::abs(value) >= opt_.min_significance * sigma)) {
       why = "not significantly away from zero";
-    } else if (why == nullptr && structure_left &&
-               (pi < 0 || c.fraction < opt_.min_explains_fraction)) {
+    } else if (structure_left && (pi < 0 || c.fraction < opt_.min_explains_fraction)) {
       why = "takes up only part of structure that stays unexplained; not claimed";
     }
     if (why != nullptr) {
@@ -655,7 +681,10 @@ AuditResult Auditor::run(PlotData* plot) {
   // then tested against it) or the residual is above the white noise at all;
   // a recording at the noise has nothing to describe.
   const double ratio0 = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
-  const State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  baseline_chi2_ = baseline.fit.chi2;
+  baseline_n_ = static_cast<double>(baseline.fit.n_res);
+  State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  full = drop_unneeded(std::move(full), chosen, out);
   // Structure is left when the description found some, or when the residual
   // stays above the noise including its slow (coloured) part.
   const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));
@@ -670,7 +699,7 @@ AuditResult Auditor::run(PlotData* plot) {
   }
   const bool structure_left =
       ratio / slow > opt_.unexplained_ratio || !out.description.terms.empty();
-  weigh_findings(baseline, full, ft, chosen, structure_left, out);
+  weigh_findings(full, ft, chosen, structure_left, out);
   report_baseline(baseline, full, !chosen.empty() || !out.description.terms.empty(), out);
   claim_findings(full, chosen, out);
   report_locations(baseline, ft, out);
