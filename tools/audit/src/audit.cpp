@@ -12,6 +12,7 @@
 
 #include "audit/plots.hpp"
 #include "dataset.hpp"
+#include "description.hpp"
 #include "dsp/wave_variables.hpp"
 #include "fit.hpp"
 #include "model.hpp"
@@ -52,6 +53,31 @@ struct State {
   bool feedthrough = false;
 };
 
+Mask with_term(Mask m, const GenericTerm& t) {
+  for (int i : t.params())
+    m[static_cast<std::size_t>(i)] = true;
+  return m;
+}
+
+// Effects taken by the forward selection, in the order they were taken.
+struct Chosen {
+  Effect effect;
+  double dbic = 0.0;
+  double dchi = 0.0;  // chi^2 removed by it when it was added
+  // Set by weigh_findings(): value, 1-sigma (catalogue unit) and the share of
+  // the baseline's misfit it removes given everything else (-1: edges).
+  double value = 0.0, sigma = 0.0, fraction = 0.0;
+  bool unique_checked = false;  // fraction from a drop-one refit
+};
+
+// One candidate added to the current model.
+struct Candidate {
+  Effect e;
+  State s;
+  double dbic;
+  double value, sigma;
+};
+
 class Auditor {
  public:
   Auditor(const recording::Recording& rec, const AuditOptions& opt)
@@ -62,7 +88,7 @@ class Auditor {
  private:
   double n_free_res() const { return 4.0 * static_cast<double>(n_blocks_fit_); }
   bool testable(Effect e) const;
-  State fit_state(const Mask& mask, const Params& start, bool feedthrough);
+  State fit_state(const Mask& mask, const Params& start, bool feedthrough, int max_iterations = 30);
   double ln_neff(const State& s) const {
     return std::log(std::max(10.0, s.kappa * static_cast<double>(s.fit.n_res)));
   }
@@ -72,11 +98,36 @@ class Auditor {
     return dchi - extra * ln_neff(next);
   }
   double heldout_rms(const Mask& mask, const Params& start);
+  double rms_v(const State& s) const;
+  double slow_noise_factor(const State& s) const;
+
+  // Steps of run(), in order.
+  Params start_params() const;
+  Mask baseline_mask() const;
+  State fit_baseline(AuditResult& out);
+  State adopt_block_noise(const Mask& base, State cur, AuditResult& out);
+  State weight_forced_segments(const Mask& base, State cur);
+  void describe_data(AuditResult& out) const;
+  std::vector<Candidate> score_candidates(const State& cur, const std::vector<Chosen>& chosen,
+                                          bool first_step, AuditResult& out);
+  void retest_runner_up(const std::vector<Candidate>& cands, AuditResult& out);
+  std::vector<Chosen> forward_select(State& cur, AuditResult& out);
+  void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
+                        AuditResult& out);
+  State describe(const State& cat, AuditResult& out);
+  State drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out);
+  void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
+                      bool structure_left, AuditResult& out);
+  void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
+  void claim_findings(const State& cur, const std::vector<Chosen>& chosen, AuditResult& out);
+  void report_locations(const State& baseline, const FeedStat& ft, AuditResult& out);
+  void set_verdict(const State& cur, const FeedStat& ft, bool structure_left, AuditResult& out);
 
   AuditOptions opt_;
   Dataset d_;
   EvalOptions eo_;
   std::size_t n_blocks_fit_ = 0;
+  double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
 };
 
 bool Auditor::testable(Effect e) const {
@@ -90,11 +141,12 @@ bool Auditor::testable(Effect e) const {
   }
 }
 
-State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough) {
+State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough,
+                         int max_iterations) {
   State s;
   s.mask = mask;
   s.feedthrough = feedthrough;
-  s.fit = fit(d_, start, mask, eo_);
+  s.fit = fit(d_, start, mask, eo_, max_iterations);
   evaluate(d_, s.fit.p, eo_, s.res);
   s.kappa = effective_fraction(s.res, static_cast<std::size_t>(n_free_res()));
   return s;
@@ -116,28 +168,67 @@ double Auditor::heldout_rms(const Mask& mask, const Params& start) {
   return std::sqrt(s / static_cast<double>(r.size())) * d_.noise_v;
 }
 
-AuditResult Auditor::run(PlotData* plot) {
-  AuditResult out;
-  out.notes = d_.notes;
-  for (const auto& s : d_.free)
-    n_blocks_fit_ += s.n_blocks;
-  // Start values: decay rate from the energy of each free segment.
-  Params p0{};
-  {
-    double num = 0.0, den = 0.0;
-    for (const auto& s : d_.free) {
-      const Block& a = d_.blocks[s.first_block];
-      const Block& b = d_.blocks[s.first_block + s.n_blocks - 1];
-      const double ea = std::norm(a.x) + std::norm(a.y), eb = std::norm(b.x) + std::norm(b.y);
-      if (ea > 0 && eb > 0 && b.t_s > a.t_s) {
-        num += -0.5 * std::log(eb / ea);
-        den += b.t_s - a.t_s;
+double Auditor::rms_v(const State& s) const {
+  double acc = 0.0;
+  const auto n = static_cast<std::size_t>(n_free_res());
+  for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
+    acc += s.res[i] * s.res[i];
+  return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
+}
+
+// Variance of the block residuals at long lags over the white level: half
+// the mean square of their first differences at stride m within segments,
+// for m doubling up to 64 blocks while it grows by less than 2x per doubling.
+// White noise stays at 1, 1/f-like noise grows slowly (about logarithmically),
+// and a smooth structure grows 4x per doubling and stops the search, so it
+// is not taken for noise.
+double Auditor::slow_noise_factor(const State& s) const {
+  auto half_d = [&](std::size_t m) {
+    double acc = 0.0, cnt = 0.0;
+    std::size_t k0 = 0;
+    for (const auto& seg : d_.free) {
+      for (std::size_t b = m; b < seg.n_blocks; ++b) {
+        const std::size_t k = k0 + 4 * b;
+        for (std::size_t c = 0; c < 4; ++c) {
+          const double d1 = s.res[k + c] - s.res[k - 4 * m + c];
+          acc += d1 * d1, cnt += 2.0;
+        }
       }
+      k0 += 4 * seg.n_blocks;
     }
-    p0[kNu] = den > 0 ? std::max(num / den, 1e-6) : 1e-3;
-    p0[kK] = d_.angular_gain;
-    p0[kCor] = 1.0;
+    return cnt > 100.0 ? acc / cnt : -1.0;
+  };
+  double level = std::max(1.0, half_d(1));
+  for (std::size_t m = 2; m <= 64; m *= 2) {
+    const double next = half_d(m);
+    if (next < 0.0 || next > 2.0 * level) break;
+    level = std::max(level, next);
   }
+  return level;
+}
+
+// Start values: decay rate from the energy of each free segment.
+Params Auditor::start_params() const {
+  Params p0{};
+  double num = 0.0, den = 0.0;
+  for (const auto& s : d_.free) {
+    const Block& a = d_.blocks[s.first_block];
+    const Block& b = d_.blocks[s.first_block + s.n_blocks - 1];
+    const double ea = std::norm(a.x) + std::norm(a.y), eb = std::norm(b.x) + std::norm(b.y);
+    if (ea > 0 && eb > 0 && b.t_s > a.t_s) {
+      num += -0.5 * std::log(eb / ea);
+      den += b.t_s - a.t_s;
+    }
+  }
+  p0[kNu] = den > 0 ? std::max(num / den, 1e-6) : 1e-3;
+  p0[kK] = d_.angular_gain;
+  p0[kCor] = 1.0;
+  return p0;
+}
+
+// The seed's parameters; K (and the second-order Coriolis factor) only when
+// the free decays precess far enough to observe it.
+Mask Auditor::baseline_mask() const {
   Mask base{};
   for (int i : {kDw0, kNu, kDnuC, kDnuS, kDwC, kDwS})
     base[static_cast<std::size_t>(i)] = true;
@@ -146,85 +237,29 @@ AuditResult Auditor::run(PlotData* plot) {
     precession += std::abs(d_.blocks[s.first_block].rate_rad_s) * (s.t1_s - s.t0_s);
   }
   if (precession * d_.angular_gain > 1.0) base[kK] = base[kCor] = true;
+  return base;
+}
 
-  // Baseline on the free decays alone, then the excitation-segment frequencies
-  // join with their scatter as weight.
-  State cur = fit_state(base, p0, false);
-  {
-    // Noise correlated over a few samples makes the block means noisier than
-    // the white level from second differences of the samples says. Measure the
-    // block noise from second differences of the baseline's block residuals
-    // (slow structure cancels there, noise does not) and use the larger.
-    // Stride m between the blocks of the difference: grows while the noise
-    // is still correlated (modest growth); slow structure would grow ~m^4
-    // and stops the search.
-    auto second_diff_var = [&](std::size_t m) {
-      double acc = 0.0, cnt = 0.0;
-      std::size_t k0 = 0;
-      for (const auto& seg : d_.free) {
-        for (std::size_t b = 2 * m; b < seg.n_blocks; ++b) {
-          const std::size_t k = k0 + 4 * b;
-          for (std::size_t c = 0; c < 4; ++c) {
-            const double d2 =
-                cur.res[k + c] - 2.0 * cur.res[k - 4 * m + c] + cur.res[k - 8 * m + c];
-            acc += d2 * d2, cnt += 6.0;
-          }
-        }
-        k0 += 4 * seg.n_blocks;
-      }
-      return cnt > 0.0 ? acc / cnt : 1.0;
-    };
-    double lambda = second_diff_var(1);
-    for (std::size_t m = 2; m <= 8; m *= 2) {
-      const double next = second_diff_var(m);
-      if (next > 4.0 * lambda) break;
-      lambda = std::max(lambda, next);
-    }
-    if (lambda > 1.2) {
-      const double f = std::sqrt(lambda);
-      d_.noise_v *= f;
-      for (auto& fs : d_.forced)
-        fs.se_rad_s *= f;
-      char buf[160];
-      std::snprintf(buf, sizeof buf,
-                    "noise is correlated over samples: block noise %.2f x the white level of the "
-                    "samples, used as the noise",
-                    f);
-      out.notes.push_back(buf);
-      cur = fit_state(base, cur.fit.p, false);
-    }
+// Baseline on the free decays alone, then the excitation-segment frequencies
+// join with their scatter as weight.
+State Auditor::fit_baseline(AuditResult& out) {
+  const Mask base = baseline_mask();
+  // Several starts of the damping anisotropy (dmu 0.05 in four directions of
+  // 4 th_mu): a baseline caught in a local minimum would be the start of
+  // every candidate after it.
+  const Params p0 = start_params();
+  // The starts are compared after a few iterations; the best is refined.
+  State cur = fit_state(base, p0, false, 4);
+  for (int k = 0; k < 4; ++k) {
+    Params q = p0;
+    q[kDnuC] = 0.05 * p0[kNu] * std::cos(0.5 * kPi * k);
+    q[kDnuS] = 0.05 * p0[kNu] * std::sin(0.5 * kPi * k);
+    State s = fit_state(base, q, false, 4);
+    if (s.fit.chi2 < cur.fit.chi2 - 1e-6 * cur.fit.chi2) cur = std::move(s);
   }
-  if (d_.forced.size() >= 3) {
-    // Weight of each excitation segment: its white-noise error and the
-    // scatter the baseline leaves beyond it. The scatter is measured after
-    // taking out what the frequency-shifting candidates could explain (pump
-    // voltage squared, amplitude squared, temperature), so that the signature
-    // of an effect is not counted as noise; with few segments only the pump
-    // term is taken out.
-    const auto fr = forced_residuals(d_, cur.fit.p);
-    const std::size_t n = fr.size();
-    const int p = n >= 8 ? 3 : 1;
-    Eigen::MatrixXd h(static_cast<Eigen::Index>(n), p);
-    Eigen::VectorXd y(static_cast<Eigen::Index>(n));
-    double se2 = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& f = d_.forced[i];
-      const auto r = static_cast<Eigen::Index>(i);
-      h(r, 0) = f.mean_v2;
-      if (p == 3) h(r, 1) = f.mean_a2, h(r, 2) = f.mean_temp_c - d_.temp_ref_c;
-      y(r) = fr[i];
-      se2 += f.se_rad_s * f.se_rad_s / static_cast<double>(n);
-    }
-    const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
-    const double rss = (y - h * coef).squaredNorm();
-    const double extra2 = std::max(
-        0.0,
-        rss / static_cast<double>(std::max<std::size_t>(1, n - static_cast<std::size_t>(p))) - se2);
-    for (auto& f : d_.forced)
-      f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
-    eo_.use_forced = true;
-    cur = fit_state(base, cur.fit.p, false);
-  }
+  cur = fit_state(base, cur.fit.p, false);
+  cur = adopt_block_noise(base, cur, out);
+  if (d_.forced.size() >= 3) cur = weight_forced_segments(base, cur);
   if (std::getenv("HRG_AUDIT_DEBUG")) {
     const auto fr = forced_residuals(d_, cur.fit.p);
     for (std::size_t i = 0; i < fr.size(); ++i) {
@@ -236,7 +271,84 @@ AuditResult Auditor::run(PlotData* plot) {
     std::fprintf(stderr, "baseline chi2 %.1f n %zu kappa %.3f\n", cur.fit.chi2, cur.fit.n_res,
                  cur.kappa);
   }
-  const State baseline = cur;
+  return cur;
+}
+
+// Noise correlated over a few samples makes the block means noisier than the
+// white level from second differences of the samples says. Measure the block
+// noise from second differences of the baseline's block residuals (slow
+// structure cancels there, noise does not) and use the larger. Stride m
+// between the blocks of the difference: grows while the noise is still
+// correlated (modest growth); slow structure would grow ~m^4 and stops the
+// search.
+State Auditor::adopt_block_noise(const Mask& base, State cur, AuditResult& out) {
+  auto second_diff_var = [&](std::size_t m) {
+    double acc = 0.0, cnt = 0.0;
+    std::size_t k0 = 0;
+    for (const auto& seg : d_.free) {
+      for (std::size_t b = 2 * m; b < seg.n_blocks; ++b) {
+        const std::size_t k = k0 + 4 * b;
+        for (std::size_t c = 0; c < 4; ++c) {
+          const double d2 = cur.res[k + c] - 2.0 * cur.res[k - 4 * m + c] + cur.res[k - 8 * m + c];
+          acc += d2 * d2, cnt += 6.0;
+        }
+      }
+      k0 += 4 * seg.n_blocks;
+    }
+    return cnt > 0.0 ? acc / cnt : 1.0;
+  };
+  double lambda = second_diff_var(1);
+  for (std::size_t m = 2; m <= 8; m *= 2) {
+    const double next = second_diff_var(m);
+    if (next > 4.0 * lambda) break;
+    lambda = std::max(lambda, next);
+  }
+  if (lambda <= 1.2) return cur;
+  const double f = std::sqrt(lambda);
+  d_.noise_v *= f;
+  for (auto& fs : d_.forced)
+    fs.se_rad_s *= f;
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "noise is correlated over samples: block noise %.2f x the white level of the "
+                "samples, used as the noise",
+                f);
+  out.notes.push_back(buf);
+  return fit_state(base, cur.fit.p, false);
+}
+
+// Weight of each excitation segment: its white-noise error and the scatter
+// the baseline leaves beyond it. The scatter is measured after taking out
+// what the frequency-shifting candidates could explain (pump voltage squared,
+// amplitude squared, temperature), so that the signature of an effect is not
+// counted as noise; with few segments only the pump term is taken out.
+State Auditor::weight_forced_segments(const Mask& base, State cur) {
+  const auto fr = forced_residuals(d_, cur.fit.p);
+  const std::size_t n = fr.size();
+  const int p = n >= 8 ? 3 : 1;
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), p);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  double se2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& f = d_.forced[i];
+    const auto r = static_cast<Eigen::Index>(i);
+    h(r, 0) = f.mean_v2;
+    if (p == 3) h(r, 1) = f.mean_a2, h(r, 2) = f.mean_temp_c - d_.temp_ref_c;
+    y(r) = fr[i];
+    se2 += f.se_rad_s * f.se_rad_s / static_cast<double>(n);
+  }
+  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+  const double rss = (y - h * coef).squaredNorm();
+  const double extra2 = std::max(
+      0.0,
+      rss / static_cast<double>(std::max<std::size_t>(1, n - static_cast<std::size_t>(p))) - se2);
+  for (auto& f : d_.forced)
+    f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
+  eo_.use_forced = true;
+  return fit_state(base, cur.fit.p, false);
+}
+
+void Auditor::describe_data(AuditResult& out) const {
   out.noise_v = d_.noise_v;
   out.free_segments = static_cast<int>(d_.free.size());
   out.forced_segments = static_cast<int>(d_.forced.size());
@@ -244,55 +356,78 @@ AuditResult Auditor::run(PlotData* plot) {
   out.samples_per_block = d_.samples_per_block;
   for (const auto& s : d_.free)
     out.heldout_segments += s.heldout ? 1 : 0;
+}
 
-  // Forward selection.
-  std::vector<Effect> chosen;
-  std::vector<double> chosen_dbic, chosen_dchi;
-  FeedStat ft;
+// Every effect not yet chosen, added to the current model alone, best first.
+// On the first step each one's evidence and detection threshold is recorded.
+// Drive feedthrough is tested at the end, against the final free-decay model:
+// edge jumps are only evidence once the decays themselves are fitted.
+std::vector<Candidate> Auditor::score_candidates(const State& cur,
+                                                 const std::vector<Chosen>& chosen, bool first_step,
+                                                 AuditResult& out) {
+  std::vector<Candidate> cands;
+  for (const auto& info : effect_table()) {
+    const Effect e = info.effect;
+    if (std::any_of(chosen.begin(), chosen.end(), [&](const Chosen& c) { return c.effect == e; }))
+      continue;
+    if (!testable(e)) {
+      if (first_step) out.candidates.push_back({e, false, 0.0, 0.0, 0.0, 0.0});
+      continue;
+    }
+    if (e == Effect::drive_feedthrough) {
+      if (first_step) {
+        const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
+        out.candidates.push_back({e, true, std::max(ft.c_x, ft.c_y), ft.sigma,
+                                  ft.dchi2 - 4.0 * ln_neff(cur),
+                                  std::max(ft.threshold, kDetectionSigmas * ft.sigma)});
+      }
+      continue;
+    }
+    Mask m = cur.mask;
+    const auto pi = static_cast<std::size_t>(param_of(e));
+    m[pi] = true;
+    State s = fit_state(m, cur.fit.p, cur.feedthrough);
+    const double dbic = delta_bic(cur, s, 1);
+    const double sig = to_catalogue(e, s.fit.sigma[pi]) / std::sqrt(s.kappa);
+    if (first_step) {
+      out.candidates.push_back({e, true, to_catalogue(e, s.fit.p[pi]), std::abs(sig), dbic,
+                                std::abs(sig) * std::max(kDetectionSigmas, std::sqrt(ln_neff(s)))});
+    }
+    const double value = to_catalogue(e, s.fit.p[pi]);
+    cands.push_back({e, std::move(s), dbic, value, sig});
+  }
+  std::sort(cands.begin(), cands.end(),
+            [](const Candidate& a, const Candidate& b) { return a.dbic > b.dbic; });
+  return cands;
+}
+
+// Runner-up close to the winner: re-test it given the winner; when it adds
+// nothing the two explain the same mismatch and the verdict is ambiguous.
+void Auditor::retest_runner_up(const std::vector<Candidate>& cands, AuditResult& out) {
+  if (cands.size() < 2 || cands[1].dbic <= opt_.min_delta_bic ||
+      cands[0].dbic - cands[1].dbic >= opt_.ambiguity_bic)
+    return;
+  const Candidate& win = cands[0];
+  const Candidate& ru = cands[1];
+  Mask m = win.s.mask;
+  m[static_cast<std::size_t>(param_of(ru.e))] = true;
+  const State s2 = fit_state(m, win.s.fit.p, false);
+  if (delta_bic(win.s, s2, 1) > opt_.min_delta_bic) return;
+  out.alternatives.push_back({ru.e, ru.value, ru.dbic,
+                              "explains the same mismatch almost as well; not needed once "
+                              "the first is in"});
+  out.ambiguity_experiment = std::string(effect_info(win.e).id) + " vs " + effect_info(ru.e).id +
+                             ": " + effect_info(win.e).separating_experiment;
+}
+
+// Forward selection refitting everything at each step; `cur` ends as the
+// selected model.
+std::vector<Chosen> Auditor::forward_select(State& cur, AuditResult& out) {
+  std::vector<Chosen> chosen;
   bool first_step = true;
   while (chosen.size() < 4) {
-    struct Cand {
-      Effect e;
-      State s;
-      double dbic;
-      double value, sigma;
-    };
-    std::vector<Cand> cands;
-    for (const auto& info : effect_table()) {
-      const Effect e = info.effect;
-      if (std::find(chosen.begin(), chosen.end(), e) != chosen.end()) continue;
-      const bool ok = testable(e);
-      if (!ok) {
-        if (first_step) out.candidates.push_back({e, false, 0.0, 0.0, 0.0, 0.0});
-        continue;
-      }
-      if (e == Effect::drive_feedthrough) {
-        // Tested at the end, against the final free-decay model: edge jumps
-        // are only evidence once the decays themselves are fitted.
-        if (first_step) {
-          ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
-          out.candidates.push_back({e, true, std::max(ft.c_x, ft.c_y), ft.sigma,
-                                    ft.dchi2 - 4.0 * ln_neff(cur),
-                                    std::max(ft.threshold, kDetectionSigmas * ft.sigma)});
-        }
-        continue;
-      }
-      Mask m = cur.mask;
-      const auto pi = static_cast<std::size_t>(param_of(e));
-      m[pi] = true;
-      State s = fit_state(m, cur.fit.p, cur.feedthrough);
-      const double dbic = delta_bic(cur, s, 1);
-      cands.push_back({e, s, dbic, to_catalogue(e, s.fit.p[pi]),
-                       to_catalogue(e, s.fit.sigma[pi]) / std::sqrt(s.kappa)});
-      if (first_step) {
-        const double sig = std::abs(to_catalogue(e, s.fit.sigma[pi])) / std::sqrt(s.kappa);
-        out.candidates.push_back({e, true, to_catalogue(e, s.fit.p[pi]), sig, dbic,
-                                  sig * std::max(kDetectionSigmas, std::sqrt(ln_neff(s)))});
-      }
-    }
+    std::vector<Candidate> cands = score_candidates(cur, chosen, first_step, out);
     first_step = false;
-    std::sort(cands.begin(), cands.end(),
-              [](const Cand& a, const Cand& b) { return a.dbic > b.dbic; });
     if (cands.empty() || cands[0].dbic < opt_.min_delta_bic) {
       for (const auto& c : cands) {
         if (c.dbic > 0.0) {
@@ -302,50 +437,30 @@ AuditResult Auditor::run(PlotData* plot) {
       }
       break;
     }
-    const Cand& win = cands[0];
-    // Runner-up close to the winner: re-test it given the winner.
-    if (cands.size() > 1 && cands[1].dbic > opt_.min_delta_bic &&
-        win.dbic - cands[1].dbic < opt_.ambiguity_bic) {
-      const Cand& ru = cands[1];
-      bool both = false;
-      {
-        Mask m = win.s.mask;
-        m[static_cast<std::size_t>(param_of(ru.e))] = true;
-        const State s2 = fit_state(m, win.s.fit.p, false);
-        both = delta_bic(win.s, s2, 1) > opt_.min_delta_bic;
-      }
-      if (!both) {
-        out.alternatives.push_back({ru.e, ru.value, ru.dbic,
-                                    "explains the same mismatch almost as well; not needed once "
-                                    "the first is in"});
-        out.ambiguity_experiment = std::string(effect_info(win.e).id) + " vs " +
-                                   effect_info(ru.e).id + ": " +
-                                   effect_info(win.e).separating_experiment;
-      }
-    }
-    chosen.push_back(win.e);
-    chosen_dbic.push_back(win.dbic);
-    chosen_dchi.push_back(cur.fit.chi2 - win.s.fit.chi2);
-    cur = win.s;
+    retest_runner_up(cands, out);
+    chosen.push_back({cands[0].e, cands[0].dbic, cur.fit.chi2 - cands[0].s.fit.chi2});
+    cur = std::move(cands[0].s);
   }
+  return chosen;
+}
 
-  // Drive feedthrough against the final model.
-  ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
-  if (testable(Effect::drive_feedthrough)) {
-    const double dbic = ft.dchi2 - 4.0 * ln_neff(cur);
-    if (dbic >= opt_.min_delta_bic) {
-      chosen.push_back(Effect::drive_feedthrough);
-      chosen_dbic.push_back(dbic);
-      chosen_dchi.push_back(ft.dchi2);
-    } else if (dbic > 0.0) {
-      out.alternatives.push_back({Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic,
-                                  "some evidence, below the acceptance level"});
-    }
+// Drive feedthrough against the final model.
+void Auditor::test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
+                               AuditResult& out) {
+  if (!testable(Effect::drive_feedthrough)) return;
+  const double dbic = ft.dchi2 - 4.0 * ln_neff(cur);
+  if (dbic >= opt_.min_delta_bic) {
+    chosen.push_back({Effect::drive_feedthrough, dbic, ft.dchi2});
+  } else if (dbic > 0.0) {
+    out.alternatives.push_back({Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic,
+                                "some evidence, below the acceptance level"});
   }
+}
 
-  // Final numbers.
-  out.baseline.angular_gain = baseline.fit.p[kK];
+void Auditor::report_baseline(const State& baseline, const State& cur, bool any_chosen,
+                              AuditResult& out) {
   const Params& pb = baseline.fit.p;
+  out.baseline.angular_gain = pb[kK];
   out.baseline.f_hz = d_.f_ref_hz + (d_.carrier_rad_s + pb[kDw0]) / (2.0 * kPi);
   out.baseline.nu_per_s = pb[kNu];
   out.baseline.dmu = std::hypot(pb[kDnuC], pb[kDnuS]) / pb[kNu];
@@ -354,78 +469,242 @@ AuditResult Auditor::run(PlotData* plot) {
   out.baseline.theta_w_deg = std::atan2(pb[kDwS], pb[kDwC]) / 4.0 * kRadToDeg;
   out.baseline.q = kPi * out.baseline.f_hz / pb[kNu];
   out.n_effective = cur.kappa * static_cast<double>(cur.fit.n_res);
-  auto rms_v = [&](const State& s) {
-    double acc = 0.0;
-    const auto n = static_cast<std::size_t>(n_free_res());
-    for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
-      acc += s.res[i] * s.res[i];
-    return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
-  };
   out.fit_rms_before_v = rms_v(baseline);
   out.fit_rms_after_v = rms_v(cur);
   out.heldout_rms_v = heldout_rms(baseline.mask, baseline.fit.p);
-  out.heldout_rms_final_v = chosen.empty() ? out.heldout_rms_v : heldout_rms(cur.mask, cur.fit.p);
-  // With structure left that no candidate takes up, a candidate that only
-  // nibbles at it is not a finding: only effects that explain a real share of
-  // the baseline's misfit are claimed, the rest are listed as alternatives.
-  const double ratio = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
-  const bool structure_left = ratio > opt_.unexplained_ratio;
-  const double excess0 = baseline.fit.chi2 - static_cast<double>(baseline.fit.n_res);
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    if (structure_left &&
-        (chosen[i] == Effect::drive_feedthrough || chosen_dchi[i] < 0.2 * std::max(excess0, 1.0))) {
-      const auto pi = param_of(chosen[i]);
-      const double v = pi < 0 ? std::max(ft.c_x, ft.c_y)
-                              : to_catalogue(chosen[i], cur.fit.p[static_cast<std::size_t>(pi)]);
-      out.alternatives.push_back({chosen[i], v, chosen_dbic[i],
-                                  "takes up only part of structure that stays unexplained; "
-                                  "not claimed"});
+  out.heldout_rms_final_v = any_chosen ? heldout_rms(cur.mask, cur.fit.p) : out.heldout_rms_v;
+}
+
+// Generic description of what the catalogue model leaves: forward selection
+// over the generic terms on top of it (stricter evidence: a search over many
+// shapes), refitted by output error with everything else. A term is taken
+// only when it also reproduces on the held-out segments (their mean-square
+// residual falls by at least a quarter of what it falls on the fitted ones):
+// slow coloured noise fits a term on the data it sees, not on the rest) and
+// when it is material: it lowers the mean-square residual by at least
+// min_description_share of the noise variance, its slow part included (the
+// slowest octaves of 1/f noise are offsets and drifts over a recording).
+// Returns the model with the description (the catalogue model when nothing
+// is accepted).
+State Auditor::describe(const State& cat, AuditResult& out) {
+  State cur = cat;
+  std::vector<const GenericTerm*> taken;
+  const double excess0 = std::max(1.0, cat.fit.chi2 - static_cast<double>(cat.fit.n_res));
+  double heldout_cur = -1.0;
+  const double slow = slow_noise_factor(cat);
+  for (int step = 0; step < opt_.max_description_terms; ++step) {
+    const GenericTerm* best = nullptr;
+    double best_dbic = -1e300;
+    for (const auto& t : generic_terms()) {
+      if (std::find(taken.begin(), taken.end(), &t) != taken.end()) continue;
+      if (t.needs_temp && !(d_.has_temp && d_.temp_span_c > 0.02)) continue;
+      if (t.needs_forced && !eo_.use_forced) continue;
+      // Scored after a few iterations (the terms enter nearly linearly).
+      const State s = fit_state(with_term(cur.mask, t), cur.fit.p, cur.feedthrough, 2);
+      const double dbic = delta_bic(cur, s, t.n_params);
+      if (dbic > best_dbic) best_dbic = dbic, best = &t;
+    }
+    if (best == nullptr || best_dbic < opt_.min_description_bic) break;
+    State next = fit_state(with_term(cur.mask, *best), cur.fit.p, cur.feedthrough);
+    const double dbic = delta_bic(cur, next, best->n_params);
+    if (dbic < opt_.min_description_bic) break;
+    if (heldout_cur < 0.0) heldout_cur = heldout_rms(cur.mask, cur.fit.p);
+    const double heldout_next = heldout_rms(next.mask, next.fit.p);
+    const double fitted_fall = rms_v(cur) * rms_v(cur) - rms_v(next) * rms_v(next);
+    const double heldout_fall = heldout_cur * heldout_cur - heldout_next * heldout_next;
+    if (!(heldout_fall > 0.25 * fitted_fall)) break;
+    if (fitted_fall < opt_.min_description_share * slow * d_.noise_v * d_.noise_v) break;
+    out.description.terms.push_back({best->id, "", dbic, (cur.fit.chi2 - next.fit.chi2) / excess0});
+    taken.push_back(best);
+    heldout_cur = heldout_next;
+    cur = std::move(next);
+  }
+  if (taken.empty()) return cat;
+  Params sigma{};
+  for (int i = 0; i < kParamCount; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    sigma[k] = cur.fit.sigma[k] / std::sqrt(cur.kappa);
+  }
+  for (std::size_t i = 0; i < taken.size(); ++i)
+    out.description.terms[i].text = describe_term(*taken[i], d_, cur.fit.p, sigma);
+  out.description.fit_rms_before_v = rms_v(cat);
+  out.description.fit_rms_after_v = rms_v(cur);
+  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
+  out.description.heldout_rms_after_v = heldout_cur;
+  return cur;
+}
+
+// Backward elimination over the chosen catalogue effects: each is refitted
+// out of the model (every other accepted effect and the description in); the
+// weakest whose delta BIC there is below the acceptance level leaves it (an
+// alternative: what it explained, the others explain as well) and the model
+// is refitted without it, until every remaining one is needed. One at a time,
+// so that two effects that can stand for each other do not both leave.
+State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out) {
+  if (chosen.size() < 2 && out.description.terms.empty()) return full;
+  const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+  for (;;) {
+    std::size_t worst = chosen.size();
+    double worst_dbic = 1e300;
+    State worst_without;
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const int pi = param_of(chosen[k].effect);
+      if (pi < 0) continue;
+      const auto i = static_cast<std::size_t>(pi);
+      Mask m = full.mask;
+      m[i] = false;
+      Params q = full.fit.p;
+      q[i] = 0.0;
+      State without = fit_state(m, q, false);
+      const double unique_dbic = delta_bic(without, full, 1);
+      chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
+      chosen[k].unique_checked = true;
+      if (unique_dbic < worst_dbic)
+        worst_dbic = unique_dbic, worst = k, worst_without = std::move(without);
+    }
+    if (worst == chosen.size() || worst_dbic >= opt_.min_delta_bic) return full;
+    const Chosen& c = chosen[worst];
+    out.alternatives.push_back(
+        {c.effect, to_catalogue(c.effect, full.fit.p[static_cast<std::size_t>(param_of(c.effect))]),
+         c.dbic, "not needed once the other accepted effects and the description are in"});
+    chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
+    full = std::move(worst_without);
+  }
+}
+
+// A finding must carry its own weight: after drop_unneeded() it must stand
+// min_significance of its standard deviations away from zero and, with
+// structure left, remove at least min_explains_fraction of the baseline's
+// misfit beyond the noise (given everything else); otherwise it is an
+// alternative.
+void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
+                             bool structure_left, AuditResult& out) {
+  const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+  std::vector<Chosen> kept;
+  for (auto& c : chosen) {
+    const int pi = param_of(c.effect);
+    const char* why = nullptr;
+    double value = std::max(ft.c_x, ft.c_y), sigma = ft.sigma;
+    if (pi >= 0) {
+      const auto i = static_cast<std::size_t>(pi);
+      value = to_catalogue(c.effect, full.fit.p[i]);
+      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i])) / std::sqrt(full.kappa);
+      if (!c.unique_checked) c.fraction = std::max(0.0, c.dchi) / excess0;
+    } else {
+      c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
+    }
+    if (!(std::abs(value) >= opt_.min_significance * sigma)) {
+      why = "not significantly away from zero";
+    } else if (structure_left && (pi < 0 || c.fraction < opt_.min_explains_fraction)) {
+      why = "takes up only part of structure that stays unexplained; not claimed";
+    }
+    if (why != nullptr) {
+      out.alternatives.push_back({c.effect, value, c.dbic, why});
       continue;
     }
+    c.value = value, c.sigma = sigma;
+    kept.push_back(c);
+  }
+  chosen.swap(kept);
+}
+
+// The findings that carried their weight, strongest first.
+void Auditor::claim_findings(const State& cur, const std::vector<Chosen>& chosen,
+                             AuditResult& out) {
+  for (const auto& c : chosen) {
     Finding f;
-    f.effect = chosen[i];
-    f.delta_bic = chosen_dbic[i];
-    if (chosen[i] == Effect::drive_feedthrough) {
-      ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
-      f.value = std::max(ft.c_x, ft.c_y);
-      f.sigma = ft.sigma;
-    } else {
-      const auto pi = static_cast<std::size_t>(param_of(chosen[i]));
-      f.value = to_catalogue(chosen[i], cur.fit.p[pi]);
-      f.sigma = to_catalogue(chosen[i], cur.fit.sigma[pi]) / std::sqrt(cur.kappa);
-    }
+    f.effect = c.effect;
+    f.delta_bic = c.dbic;
+    f.value = c.value;
+    f.sigma = c.sigma;
+    f.significance = c.sigma > 0.0 ? std::abs(c.value) / c.sigma : 0.0;
+    f.explains_fraction = c.fraction;
     f.heldout_rms_before_v = out.heldout_rms_v;
     f.heldout_rms_after_v = out.heldout_rms_final_v;
-    f.impact = impact_text(d_, cur.fit.p, chosen[i], f.value);
+    f.impact = impact_text(d_, cur.fit.p, c.effect, f.value);
     out.findings.push_back(f);
   }
+  std::sort(out.findings.begin(), out.findings.end(),
+            [](const Finding& a, const Finding& b) { return a.delta_bic > b.delta_bic; });
+}
+
+// Where the baseline misfits (strongest eight), and where each candidate sees
+// it; `ft` is the switching-edge statistic against the selected model.
+void Auditor::report_locations(const State& baseline, const FeedStat& ft, AuditResult& out) {
   out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.use_forced, ft);
   add_candidate_locations(d_, out);
   std::sort(out.locations.begin(), out.locations.end(),
             [](const Location& a, const Location& b) { return a.score > b.score; });
   if (out.locations.size() > 8) out.locations.resize(8);
+}
 
-  std::sort(out.findings.begin(), out.findings.end(),
-            [](const Finding& a, const Finding& b) { return a.delta_bic > b.delta_bic; });
-  // Structure left after the selected model.
-  if (structure_left) {
-    const auto left = locate(d_, cur.fit.p, cur.res, eo_.use_forced,
-                             feedthrough_stat(d_, cur.fit.p, ln_neff(cur)));
+void Auditor::set_verdict(const State& cur, const FeedStat& ft, bool structure_left,
+                          AuditResult& out) {
+  if (!out.description.terms.empty()) {
+    out.unexplained_note = "structure the catalogue cannot name, described as: ";
+    for (std::size_t i = 0; i < out.description.terms.size(); ++i)
+      out.unexplained_note += (i ? "; " : "") + out.description.terms[i].text;
+    out.verdict = "unexplained";
+  } else if (structure_left) {
+    const double ratio =
+        cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res)) / slow_noise_factor(cur);
+    const auto left = locate(d_, cur.fit.p, cur.res, eo_.use_forced, ft);
     char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "residual variance %.2f x the white-noise level after the best model", ratio);
+    std::snprintf(buf, sizeof buf, "residual variance %.2f x the noise level after the best model",
+                  ratio);
     out.unexplained_note = buf;
     if (!left.empty())
       out.unexplained_note += "; largest at " + left.front().signal + ", " + left.front().where;
     out.verdict = "unexplained";
-  } else if (chosen.empty()) {
+  } else if (out.findings.empty()) {
     out.verdict = "consistent";
   } else if (!out.ambiguity_experiment.empty()) {
     out.verdict = "ambiguous";
   } else {
     out.verdict = "explained";
   }
-  if (plot) fill_plot(d_, eo_, baseline.fit.p, cur.fit.p, *plot);
+}
+
+AuditResult Auditor::run(PlotData* plot) {
+  AuditResult out;
+  out.notes = d_.notes;
+  for (const auto& s : d_.free)
+    n_blocks_fit_ += s.n_blocks;
+  const State baseline = fit_baseline(out);
+  describe_data(out);
+  State cur = baseline;
+  std::vector<Chosen> chosen = forward_select(cur, out);
+  // The switching edges against the final free-decay model.
+  const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
+  test_feedthrough(cur, ft, chosen, out);
+  // The description is looked for when something was chosen (its weight is
+  // then tested against it) or the residual is above the white noise at all;
+  // a recording at the noise has nothing to describe.
+  const double ratio0 = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  baseline_chi2_ = baseline.fit.chi2;
+  baseline_n_ = static_cast<double>(baseline.fit.n_res);
+  State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  full = drop_unneeded(std::move(full), chosen, out);
+  // Structure is left when the description found some, or when the residual
+  // stays above the noise including its slow (coloured) part.
+  const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));
+  const double slow = slow_noise_factor(full);
+  if (slow > 1.2) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "slow (coloured) noise: the residual's variance at lags of up to 64 blocks is "
+                  "%.2f x its white level, used as the noise of the structure test",
+                  slow);
+    out.notes.push_back(buf);
+  }
+  const bool structure_left =
+      ratio / slow > opt_.unexplained_ratio || !out.description.terms.empty();
+  weigh_findings(full, ft, chosen, structure_left, out);
+  report_baseline(baseline, full, !chosen.empty() || !out.description.terms.empty(), out);
+  claim_findings(full, chosen, out);
+  report_locations(baseline, ft, out);
+  set_verdict(full, ft, structure_left, out);
+  if (plot) fill_plot(d_, eo_, baseline.fit.p, full.fit.p, *plot);
   return out;
 }
 

@@ -32,8 +32,12 @@ void bench_usage(std::FILE* f) {
                "time (default 0: all cores); the results and the output do not depend on N.\n\n"
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
+               "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
                "writes one simulated campaign, optionally with one catalogue effect (a\n"
-               "firmware campaign lasts as long as its table turn; --duration is ignored).\n");
+               "firmware campaign lasts as long as its table turn; --duration is ignored),\n"
+               "1/f noise, one effect outside the catalogue (gain_ratio_drift 1/h,\n"
+               "phase_drift rad/h, offset_x V, gain_ratio_vs_temperature 1/degC) and a\n"
+               "reference that follows the resonance (f_ref_hz per row).\n");
 }
 
 bool parse_design(std::string_view name, bench::Design& d) {
@@ -74,7 +78,9 @@ int audit_bench_main(std::span<char* const> args) {
   o.jobs = batch::all_cores();
   double hours = 1.0;
   std::string emit, design_arg = "ringdown", effect;
-  double duration_s = 480.0, value = 0.0, noise_v = -1.0;
+  double duration_s = 480.0, value = 0.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
+  std::string outside;
+  bool pll = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
     const bool has_value = i + 1 < args.size();
@@ -104,6 +110,13 @@ int audit_bench_main(std::span<char* const> args) {
     } else if (a == "--effect" && i + 2 < args.size()) {
       effect = args[++i];
       value = std::atof(args[++i]);
+    } else if (a == "--flicker" && has_value) {
+      flicker_hz = std::atof(args[++i]);
+    } else if (a == "--outside" && i + 2 < args.size()) {
+      outside = args[++i];
+      outside_value = std::atof(args[++i]);
+    } else if (a == "--pll") {
+      pll = true;
     } else if (a == "--verbose") {
       o.verbose = true;
     } else {
@@ -127,6 +140,13 @@ int audit_bench_main(std::span<char* const> args) {
       return 2;
     }
     if (noise_v >= 0.0) sc.noise_v = noise_v;
+    sc.flicker_corner_hz = flicker_hz;
+    sc.pll_reference = pll;
+    if (!outside.empty() && !bench::outside_by_name(outside, sc.outside)) {
+      std::fprintf(stderr, "hrg audit-bench: unknown --outside shape '%s'\n", outside.c_str());
+      return 2;
+    }
+    sc.outside_value = outside_value;
     recording::write_recording(emit, bench::simulate(sc));
     std::printf("wrote %s (f %.6f Hz, Q %.4g, dmu %.4g, split %.4g Hz, noise %.3g V)\n",
                 emit.c_str(), sc.resonator.f_hz, sc.resonator.q, sc.resonator.dmu,

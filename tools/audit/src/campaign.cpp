@@ -106,8 +106,22 @@ Scenario random_scenario(Design design, double duration_s, uint64_t seed) {
   return s;
 }
 
+namespace {
+
+recording::Recording simulate_averaged(const Scenario& s);
+
+}  // namespace
+
 recording::Recording simulate(const Scenario& s) {
-  if (s.design == Design::firmware) return simulate_firmware(s);
+  recording::Recording rec =
+      s.design == Design::firmware ? simulate_firmware(s) : simulate_averaged(s);
+  apply_outside_effects(s, rec);
+  return rec;
+}
+
+namespace {
+
+recording::Recording simulate_averaged(const Scenario& s) {
   std::mt19937_64 g(s.seed * 104729ULL + 3ULL);
   std::normal_distribution<double> noise(0.0, s.noise_v);
   const auto segs = plan(s, g);
@@ -181,5 +195,7 @@ recording::Recording simulate(const Scenario& s) {
   rec.find_gaps();
   return rec;
 }
+
+}  // namespace
 
 }  // namespace hrg::audit::bench

@@ -25,6 +25,18 @@
 
 namespace hrg::audit::bench {
 
+// Structure outside the catalogue, for the audit's description.
+enum class OutsideEffect {
+  none,
+  gain_ratio_drift,    // y pickoff gain (1 + v (t - t_mid)/1 h)
+  phase_drift,         // y pickoff phase lag v (t - t_mid)/1 h (rad)
+  offset_x,            // constant offset of magnitude v (V) on cx_v/sx_v
+  gain_ratio_vs_temp,  // y pickoff gain (1 + v (T - T_mean)) (1/degC)
+};
+inline constexpr int kOutsideEffectCount = 4;
+const char* outside_name(OutsideEffect e);
+bool outside_by_name(const std::string& name, OutsideEffect& e);
+
 struct Scenario {
   Design design = Design::ringdown;
   sim::ResonatorParams resonator;
@@ -37,6 +49,15 @@ struct Scenario {
   double sample_rate_hz = 200.0;
   double temp_mean_c = 25.0, temp_swing_c = 1.0;  // slow temperature swing
   double temp_phase_rad = 0.0;
+  // Beyond sim_target, applied to the recorded signals (outside_effects.cpp):
+  // 1/f-like noise on each demodulated signal, its spectral density equal to
+  // the white noise's at this corner (0: white noise only); one effect the
+  // catalogue does not hold; a demodulation reference that follows the
+  // resonance like a PLL (the f_ref_hz column changes per row).
+  double flicker_corner_hz = 0.0;
+  OutsideEffect outside = OutsideEffect::none;
+  double outside_value = 0.0;  // see OutsideEffect
+  bool pll_reference = false;
   // Firmware campaigns only.
   double window_s = 1.0;         // free-decay window length
   double sweep_rate_dps = 10.0;  // case rate of the table's turn
@@ -53,6 +74,10 @@ bool conceal_by_id(Scenario& s, const std::string& id, double value, uint64_t se
 
 // Simulates the campaign and returns the recording (deterministic in seed).
 recording::Recording simulate(const Scenario& s);
+
+// Applies the scenario's coloured noise, outside effect and PLL reference to
+// a simulated recording (deterministic in the scenario's seed).
+void apply_outside_effects(const Scenario& s, recording::Recording& rec);
 
 // The firmware campaign (simulate() of Design::firmware) and its length: the
 // ring-up, the table's turn and 10 s after it.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "dsp/wave_variables.hpp"
 
@@ -34,92 +35,123 @@ const std::vector<double>* optional_column(const recording::Recording& rec, cons
   return rec.has_column(name) ? &rec.column(name) : nullptr;
 }
 
-}  // namespace
+// The recording's columns and what the cut derives per row from them.
+struct Rows {
+  std::size_t n = 0;
+  const std::vector<double>& t;
+  const std::vector<double>& cx;
+  const std::vector<double>& sx;
+  const std::vector<double>& cy;
+  const std::vector<double>& sy;
+  const std::vector<double>& exc;
+  const std::vector<double>* pump;
+  const std::vector<double>* temp;
+  const std::vector<double>* rate;
+  const std::vector<double>* fref;
+  std::vector<bool> gap_before;
+  // Wave variables: continuous pattern angle, wave phase (in the carrier
+  // frame once derotated) and a_A^2.
+  std::vector<double> theta, phase, a2;
 
-Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
-  Dataset d;
-  const std::size_t n = rec.rows();
-  d.f_ref_hz = rec.f_ref_hz();
-  d.angular_gain = rec.angular_gain();
-  const auto& t = rec.column("t_s");
-  const auto& cx = rec.column("cx_v");
-  const auto& sx = rec.column("sx_v");
-  const auto& cy = rec.column("cy_v");
-  const auto& sy = rec.column("sy_v");
-  const auto& exc = rec.column("exc");
-  const auto* pump = optional_column(rec, "pump_v");
-  const auto* temp = optional_column(rec, "temp_c");
-  const auto* rate = optional_column(rec, "rate_dps");
-  const auto* fref = optional_column(rec, "f_ref_hz");
-  d.has_pump = pump != nullptr;
-  d.has_temp = temp != nullptr;
-  d.has_rate = rate != nullptr;
-  d.t_s = t;
+  explicit Rows(const recording::Recording& rec)
+      : n(rec.rows()),
+        t(rec.column("t_s")),
+        cx(rec.column("cx_v")),
+        sx(rec.column("sx_v")),
+        cy(rec.column("cy_v")),
+        sy(rec.column("sy_v")),
+        exc(rec.column("exc")),
+        pump(optional_column(rec, "pump_v")),
+        temp(optional_column(rec, "temp_c")),
+        rate(optional_column(rec, "rate_dps")),
+        fref(optional_column(rec, "f_ref_hz")),
+        gap_before(n, false) {
+    for (const auto& g : rec.gaps())
+      gap_before[g.row] = true;
+  }
+  double rate_rad_s(std::size_t i) const { return rate ? (*rate)[i] * kPi / 180.0 : 0.0; }
+};
 
-  // Runs of equal exc, cut at gaps (a gap is never bridged by the model).
-  std::vector<bool> gap_before(n, false);
-  for (const auto& g : rec.gaps())
-    gap_before[g.row] = true;
+// Runs of equal exc, cut at gaps (a gap is never bridged by the model).
+std::vector<Run> cut_runs(const Rows& r) {
   std::vector<Run> runs;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool e = exc[i] != 0.0;
-    if (runs.empty() || runs.back().exc != e || gap_before[i]) {
+  for (std::size_t i = 0; i < r.n; ++i) {
+    const bool e = r.exc[i] != 0.0;
+    if (runs.empty() || runs.back().exc != e || r.gap_before[i]) {
       runs.push_back({i, i, e});
     } else {
       runs.back().last = i;
     }
   }
+  return runs;
+}
+
+void note_gaps(const recording::Recording& rec, Dataset& d) {
   for (const auto& g : rec.gaps()) {
     d.notes.push_back("gap of " + std::to_string(g.t_after_s - g.t_before_s) +
                       " s after t = " + std::to_string(g.t_before_s) + " s (file line " +
                       std::to_string(g.line) + "): segments cut there, nothing interpolated");
   }
+}
 
-  // Wave variables of the raw rows; continuous pattern angle and phase.
-  std::vector<double> theta(n), phase(n), a2(n);
+// Wave variables of the raw rows; continuous pattern angle and phase.
+void wave_rows(Rows& r) {
+  r.theta.resize(r.n), r.phase.resize(r.n), r.a2.resize(r.n);
   dsp::ThetaUnwrapper<double> unwrap;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto w = dsp::wave_variables<double>({cx[i], sx[i], cy[i], sy[i]});
-    theta[i] = unwrap.update(w.theta_A_rad);
-    a2[i] = w.a_A * w.a_A;
-    phase[i] = w.phase_rad;
-    if (i > 0 && !gap_before[i]) {
+  for (std::size_t i = 0; i < r.n; ++i) {
+    const auto w = dsp::wave_variables<double>({r.cx[i], r.sx[i], r.cy[i], r.sy[i]});
+    r.theta[i] = unwrap.update(w.theta_A_rad);
+    r.a2[i] = w.a_A * w.a_A;
+    r.phase[i] = w.phase_rad;
+    if (i > 0 && !r.gap_before[i]) {
       // The wave phase is defined modulo pi: keep it continuous.
-      phase[i] = phase[i - 1] + std::remainder(phase[i] - phase[i - 1], kPi);
+      r.phase[i] = r.phase[i - 1] + std::remainder(r.phase[i] - r.phase[i - 1], kPi);
     }
   }
-  // Phase in the frame of the fixed metadata reference.
-  std::vector<double> ref_phase(n, 0.0);
-  if (fref != nullptr) {
-    for (std::size_t i = 1; i < n; ++i) {
-      const double f_mid = 0.5 * ((*fref)[i] + (*fref)[i - 1]) - d.f_ref_hz;
-      ref_phase[i] = ref_phase[i - 1] + 2.0 * kPi * f_mid * (t[i] - t[i - 1]);
-    }
+}
+
+// Phase of each row's demodulation reference (column f_ref_hz, a reference
+// that follows the resonance) against the fixed metadata reference.
+std::vector<double> reference_phase(const Rows& r, double f_ref_hz) {
+  std::vector<double> ref_phase(r.n, 0.0);
+  if (r.fref == nullptr) return ref_phase;
+  for (std::size_t i = 1; i < r.n; ++i) {
+    const double f_mid = 0.5 * ((*r.fref)[i] + (*r.fref)[i - 1]) - f_ref_hz;
+    ref_phase[i] = ref_phase[i - 1] + 2.0 * kPi * f_mid * (r.t[i] - r.t[i - 1]);
   }
-  // Carrier: median wave frequency over the free-decay runs.
+  return ref_phase;
+}
+
+// Carrier: median wave frequency over the free-decay runs; the envelopes and
+// the wave phase are turned into the frame rotating at it.
+void derotate(Rows& r, const std::vector<Run>& runs, Dataset& d) {
+  const std::vector<double> ref_phase = reference_phase(r, d.f_ref_hz);
   std::vector<double> slopes;
-  for (const auto& r : runs) {
-    if (r.exc || r.last - r.first + 1 < kMinFreeSamples) continue;
-    const double dphi = (phase[r.last] + ref_phase[r.last]) - (phase[r.first] + ref_phase[r.first]);
-    slopes.push_back(dphi / (t[r.last] - t[r.first]));
+  for (const auto& run : runs) {
+    if (run.exc || run.last - run.first + 1 < kMinFreeSamples) continue;
+    const double dphi =
+        (r.phase[run.last] + ref_phase[run.last]) - (r.phase[run.first] + ref_phase[run.first]);
+    slopes.push_back(dphi / (r.t[run.last] - r.t[run.first]));
   }
   if (slopes.empty()) {
     throw std::runtime_error("recording has no free-decay segment (exc = 0) of at least " +
                              std::to_string(kMinFreeSamples) + " samples: nothing to fit");
   }
   d.carrier_rad_s = median(slopes);
-  d.frame_phase_rad.resize(n);
-  d.x.resize(n);
-  d.y.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    d.frame_phase_rad[i] = ref_phase[i] - d.carrier_rad_s * (t[i] - t[0]);
+  d.frame_phase_rad.resize(r.n);
+  d.x.resize(r.n);
+  d.y.resize(r.n);
+  for (std::size_t i = 0; i < r.n; ++i) {
+    d.frame_phase_rad[i] = ref_phase[i] - d.carrier_rad_s * (r.t[i] - r.t[0]);
     const cplx rot = std::polar(1.0, d.frame_phase_rad[i]);
-    d.x[i] = cplx(cx[i], -sx[i]) * rot;
-    d.y[i] = cplx(cy[i], -sy[i]) * rot;
-    phase[i] += d.frame_phase_rad[i];
+    d.x[i] = cplx(r.cx[i], -r.sx[i]) * rot;
+    d.y[i] = cplx(r.cy[i], -r.sy[i]) * rot;
+    r.phase[i] += d.frame_phase_rad[i];
   }
+}
 
-  // White noise from second differences of the slow, derotated envelopes.
+// White noise from second differences of the slow, derotated envelopes.
+double white_noise_v(const std::vector<Run>& runs, const Dataset& d) {
   std::vector<double> d2;
   for (const auto& r : runs) {
     if (r.exc) continue;
@@ -132,153 +164,195 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
       d2.push_back(std::abs(ay.imag()));
     }
   }
-  d.noise_v = median(d2) * 1.482602 / std::sqrt(6.0);
-  if (!(d.noise_v > 0.0)) d.noise_v = 1e-12;
+  const double noise = median(d2) * 1.482602 / std::sqrt(6.0);
+  return noise > 0.0 ? noise : 1e-12;
+}
 
-  // Temperature reference and spans.
+// Temperature reference and the spans of temperature, free-decay a_A^2 and rate.
+// Returns the largest |rate| (rad/s).
+double measure_spans(const Rows& r, Dataset& d) {
   double tmin = 1e300, tmax = -1e300, amin = 1e300, amax = -1e300, rmin = 1e300, rmax = -1e300;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (temp) tmin = std::min(tmin, (*temp)[i]), tmax = std::max(tmax, (*temp)[i]);
-    if (exc[i] == 0.0) amin = std::min(amin, a2[i]), amax = std::max(amax, a2[i]);
-    const double rr = rate ? (*rate)[i] * kPi / 180.0 : 0.0;
+  for (std::size_t i = 0; i < r.n; ++i) {
+    if (r.temp) tmin = std::min(tmin, (*r.temp)[i]), tmax = std::max(tmax, (*r.temp)[i]);
+    if (r.exc[i] == 0.0) amin = std::min(amin, r.a2[i]), amax = std::max(amax, r.a2[i]);
+    const double rr = r.rate_rad_s(i);
     rmin = std::min(rmin, rr);
     rmax = std::max(rmax, rr);
   }
-  d.temp_ref_c = temp ? 0.5 * (tmin + tmax) : 0.0;
-  d.temp_span_c = temp ? tmax - tmin : 0.0;
+  d.temp_ref_c = r.temp ? 0.5 * (tmin + tmax) : 0.0;
+  d.temp_span_c = r.temp ? tmax - tmin : 0.0;
   d.a2_span_v2 = amax > amin ? amax - amin : 0.0;
   d.rate_span_rad_s = rmax - rmin;
+  return std::max(std::abs(rmin), std::abs(rmax));
+}
 
-  // Block length: enough blocks for the envelope, short enough for the
-  // fourth-order propagator (|A'| T_block <= 0.2).
+// Block length: enough blocks for the envelope, short enough for the
+// fourth-order propagator (|A'| T_block <= 0.2), at most max_blocks blocks.
+std::size_t block_length(const std::vector<Run>& runs, double dt, double max_rate,
+                         double angular_gain, int max_blocks) {
   std::size_t n_free = 0;
   for (const auto& r : runs) {
     if (!r.exc && r.last - r.first + 1 >= kMinFreeSamples) n_free += r.last - r.first + 1;
   }
-  const double dt = rec.typical_step_s();
-  const double max_rate = std::max(std::abs(rmin), std::abs(rmax));
-  const double a_fast = max_rate * d.angular_gain + 0.05;
+  const double a_fast = max_rate * angular_gain + 0.05;
   const auto nb_acc = static_cast<std::size_t>(std::max(1.0, std::floor(0.2 / (a_fast * dt))));
   const std::size_t nb_cost =
       (n_free + static_cast<std::size_t>(max_blocks) - 1) / static_cast<std::size_t>(max_blocks);
-  const std::size_t nb = std::clamp<std::size_t>(nb_cost, 1, nb_acc);
-  d.samples_per_block = static_cast<int>(nb);
+  return std::clamp<std::size_t>(nb_cost, 1, nb_acc);
+}
 
-  std::size_t seg_index = 0;
+// Longest quiet stretch of an excitation run: the quadrature nulled and the
+// pattern not being moved by the forcers. With a quadrature a_B the forces
+// that steer the pattern pull the wave phase by -2 (a_B/a_A) theta'_cmd,
+// which no resonator parameter explains. Returns {first row, length}.
+std::pair<std::size_t, std::size_t> quiet_stretch(const Rows& r, const Run& run, const Dataset& d) {
+  const std::size_t h = 10;
+  std::size_t best_first = 0, best_len = 0, run_first = 0, run_len = 0;
+  for (std::size_t i = run.first; i <= run.last; ++i) {
+    bool ok = i >= run.first + h && i + h <= run.last;
+    if (ok) {
+      const double a = std::sqrt(r.a2[i]);
+      const auto w = dsp::wave_variables<double>({r.cx[i], r.sx[i], r.cy[i], r.sy[i]});
+      const double th_rate = (r.theta[i + h] - r.theta[i - h]) / (r.t[i + h] - r.t[i - h]);
+      const double free_rate = -0.5 * d.angular_gain * r.rate_rad_s(i);
+      ok = std::abs(w.a_B) < 1e-3 * a + 3.0 * d.noise_v && std::abs(th_rate - free_rate) < 2e-3;
+    }
+    if (ok) {
+      if (run_len == 0) run_first = i;
+      ++run_len;
+      if (run_len > best_len) best_len = run_len, best_first = run_first;
+    } else {
+      run_len = 0;
+    }
+  }
+  return {best_first, best_len};
+}
+
+// Mean wave frequency and mean inputs over the quiet part of an excitation run.
+void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d) {
+  const auto [q0, best_len] = quiet_stretch(r, run, d);
+  if (best_len < 20 || static_cast<double>(best_len) * dt_typ < 0.5) return;
+  const std::size_t q1 = q0 + best_len - 1;
+  ForcedSegment f;
+  f.first_row = q0;
+  f.last_row = q1;
+  const std::size_t k = 3;
+  double ts = 0, te = 0, ps = 0, pe = 0;
+  for (std::size_t j = 0; j < k; ++j) {
+    ts += r.t[q0 + j] / k, ps += r.phase[q0 + j] / k;
+    te += r.t[q1 - j] / k, pe += r.phase[q1 - j] / k;
+  }
+  f.t0_s = ts;
+  f.t1_s = te;
+  f.freq_rad_s = (pe - ps) / (te - ts);
+  double c4 = 0, s4 = 0, v2 = 0, aa = 0, tc = 0, rr = 0;
+  for (std::size_t i = q0; i <= q1; ++i) {
+    c4 += std::cos(4.0 * r.theta[i]);
+    s4 += std::sin(4.0 * r.theta[i]);
+    v2 += r.pump ? (*r.pump)[i] * (*r.pump)[i] : 0.0;
+    aa += r.a2[i];
+    tc += r.temp ? (*r.temp)[i] : 0.0;
+    rr += r.rate_rad_s(i);
+  }
+  const auto m = static_cast<double>(best_len);
+  f.mean_c4 = c4 / m, f.mean_s4 = s4 / m, f.mean_v2 = v2 / m, f.mean_a2 = aa / m;
+  f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
+  f.theta0_rad = r.theta[q0];
+  f.theta1_rad = r.theta[q1];
+  f.se_rad_s = std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
+  d.forced.push_back(f);
+}
+
+// One averaging block of rows [b0, b1].
+Block make_block(const Rows& r, const Dataset& d, std::size_t b0, std::size_t b1) {
+  Block b;
+  b.n = static_cast<double>(b1 - b0 + 1);
+  for (std::size_t i = b0; i <= b1; ++i)
+    b.t_s += r.t[i] / b.n;
+  for (std::size_t i = b0; i <= b1; ++i) {
+    const double tau = r.t[i] - b.t_s;
+    b.m2 += tau * tau / b.n, b.m3 += tau * tau * tau / b.n, b.m4 += tau * tau * tau * tau / b.n;
+    b.x += d.x[i] / b.n;
+    b.y += d.y[i] / b.n;
+    b.temp_c += r.temp ? (*r.temp)[i] / b.n : 0.0;
+    b.rate_rad_s += r.rate_rad_s(i) / b.n;
+    b.a2_v2 += r.a2[i] / b.n;
+    b.theta_rad += r.theta[i] / b.n;
+    b.rot += std::polar(1.0, d.frame_phase_rad[i]) / b.n;
+  }
+  return b;
+}
+
+// The switching edge between free segment `seg_index` and the excitation run
+// `fr` next to it (before it when at_start).
+void add_edge(const Rows& r, const Run& fr, std::size_t seg_index, bool at_start, Dataset& d) {
+  Edge e;
+  e.free_segment = seg_index;
+  e.at_start = at_start;
+  const std::size_t m = std::min<std::size_t>(kEdgeRows, fr.last - fr.first + 1);
+  double v = 0.0;
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t row = at_start ? fr.last - j : fr.first + j;
+    e.forced_rows.push_back(row);
+    v += r.pump ? std::abs((*r.pump)[row]) / static_cast<double>(m) : 1.0 / static_cast<double>(m);
+  }
+  e.pump_v = v;
+  const std::size_t run_rows = fr.last - fr.first + 1;
+  for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j)
+    e.slope_rows.push_back(at_start ? fr.last - j : fr.first + j);
+  if (m >= 4) d.edges.push_back(e);
+}
+
+// A free-decay run averaged into blocks of nb samples, with its edges to the
+// neighbouring excitation runs (no gap between them).
+void add_free_segment(const Rows& r, const std::vector<Run>& runs, std::size_t ri, std::size_t nb,
+                      Dataset& d) {
+  const Run& run = runs[ri];
+  FreeSegment s;
+  s.first_row = run.first;
+  s.last_row = run.last;
+  s.t0_s = r.t[run.first];
+  s.t1_s = r.t[run.last];
+  s.first_block = d.blocks.size();
+  for (std::size_t b0 = run.first; b0 <= run.last; b0 += nb)
+    d.blocks.push_back(make_block(r, d, b0, std::min(run.last, b0 + nb - 1)));
+  s.n_blocks = d.blocks.size() - s.first_block;
+  const std::size_t seg_index = d.free.size();
+  d.free.push_back(s);
+  if (ri > 0 && runs[ri - 1].exc && runs[ri - 1].last + 1 == run.first &&
+      !r.gap_before[run.first]) {
+    add_edge(r, runs[ri - 1], seg_index, true, d);
+  }
+  if (ri + 1 < runs.size() && runs[ri + 1].exc && !r.gap_before[runs[ri + 1].first]) {
+    add_edge(r, runs[ri + 1], seg_index, false, d);
+  }
+}
+
+}  // namespace
+
+Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
+  Dataset d;
+  d.f_ref_hz = rec.f_ref_hz();
+  d.angular_gain = rec.angular_gain();
+  Rows r(rec);
+  d.has_pump = r.pump != nullptr;
+  d.has_temp = r.temp != nullptr;
+  d.has_rate = r.rate != nullptr;
+  d.t_s = r.t;
+  if (r.n > 0) d.t_mid_s = 0.5 * (r.t.front() + r.t.back());
+  const std::vector<Run> runs = cut_runs(r);
+  note_gaps(rec, d);
+  wave_rows(r);
+  derotate(r, runs, d);
+  d.noise_v = white_noise_v(runs, d);
+  const double max_rate = measure_spans(r, d);
+  const double dt = rec.typical_step_s();
+  const std::size_t nb = block_length(runs, dt, max_rate, d.angular_gain, max_blocks);
+  d.samples_per_block = static_cast<int>(nb);
   for (std::size_t ri = 0; ri < runs.size(); ++ri) {
-    const Run& r = runs[ri];
-    const std::size_t len = r.last - r.first + 1;
-    if (r.exc) {
-      if (len < kMinForcedSamples) continue;
-      // Only the quiet part of an excitation segment tells the frequency: the
-      // quadrature nulled and the pattern not being moved by the forcers. With
-      // a quadrature a_B the forces that steer the pattern pull the wave phase
-      // by -2 (a_B/a_A) theta'_cmd, which no resonator parameter explains.
-      const std::size_t h = 10;
-      std::size_t best_first = 0, best_len = 0, run_first = 0, run_len = 0;
-      for (std::size_t i = r.first; i <= r.last; ++i) {
-        bool ok = i >= r.first + h && i + h <= r.last;
-        if (ok) {
-          const double a = std::sqrt(a2[i]);
-          const auto w = dsp::wave_variables<double>({cx[i], sx[i], cy[i], sy[i]});
-          const double th_rate = (theta[i + h] - theta[i - h]) / (t[i + h] - t[i - h]);
-          const double free_rate = rate ? -0.5 * d.angular_gain * (*rate)[i] * kPi / 180.0 : 0.0;
-          ok = std::abs(w.a_B) < 1e-3 * a + 3.0 * d.noise_v && std::abs(th_rate - free_rate) < 2e-3;
-        }
-        if (ok) {
-          if (run_len == 0) run_first = i;
-          ++run_len;
-          if (run_len > best_len) best_len = run_len, best_first = run_first;
-        } else {
-          run_len = 0;
-        }
-      }
-      const double dt_typ = rec.typical_step_s();
-      if (best_len < 20 || static_cast<double>(best_len) * dt_typ < 0.5) continue;
-      const std::size_t q0 = best_first, q1 = best_first + best_len - 1;
-      ForcedSegment f;
-      f.first_row = q0;
-      f.last_row = q1;
-      const std::size_t k = 3;
-      double ts = 0, te = 0, ps = 0, pe = 0;
-      for (std::size_t j = 0; j < k; ++j) {
-        ts += t[q0 + j] / k, ps += phase[q0 + j] / k;
-        te += t[q1 - j] / k, pe += phase[q1 - j] / k;
-      }
-      f.t0_s = ts;
-      f.t1_s = te;
-      f.freq_rad_s = (pe - ps) / (te - ts);
-      double c4 = 0, s4 = 0, v2 = 0, aa = 0, tc = 0, rr = 0;
-      for (std::size_t i = q0; i <= q1; ++i) {
-        c4 += std::cos(4.0 * theta[i]);
-        s4 += std::sin(4.0 * theta[i]);
-        v2 += pump ? (*pump)[i] * (*pump)[i] : 0.0;
-        aa += a2[i];
-        tc += temp ? (*temp)[i] : 0.0;
-        rr += rate ? (*rate)[i] * kPi / 180.0 : 0.0;
-      }
-      const auto m = static_cast<double>(best_len);
-      f.mean_c4 = c4 / m, f.mean_s4 = s4 / m, f.mean_v2 = v2 / m, f.mean_a2 = aa / m;
-      f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
-      f.theta0_rad = theta[q0];
-      f.theta1_rad = theta[q1];
-      f.se_rad_s =
-          std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
-      d.forced.push_back(f);
-      continue;
-    }
-    if (len < kMinFreeSamples) continue;
-    FreeSegment s;
-    s.first_row = r.first;
-    s.last_row = r.last;
-    s.t0_s = t[r.first];
-    s.t1_s = t[r.last];
-    s.first_block = d.blocks.size();
-    for (std::size_t b0 = r.first; b0 <= r.last; b0 += nb) {
-      const std::size_t b1 = std::min(r.last, b0 + nb - 1);
-      Block b;
-      b.n = static_cast<double>(b1 - b0 + 1);
-      for (std::size_t i = b0; i <= b1; ++i)
-        b.t_s += t[i] / b.n;
-      for (std::size_t i = b0; i <= b1; ++i) {
-        const double tau = t[i] - b.t_s;
-        b.m2 += tau * tau / b.n, b.m3 += tau * tau * tau / b.n, b.m4 += tau * tau * tau * tau / b.n;
-        b.x += d.x[i] / b.n;
-        b.y += d.y[i] / b.n;
-        b.temp_c += temp ? (*temp)[i] / b.n : 0.0;
-        b.rate_rad_s += rate ? (*rate)[i] * kPi / 180.0 / b.n : 0.0;
-        b.a2_v2 += a2[i] / b.n;
-        b.theta_rad += theta[i] / b.n;
-      }
-      d.blocks.push_back(b);
-    }
-    s.n_blocks = d.blocks.size() - s.first_block;
-    d.free.push_back(s);
-    // Edges with the neighbouring excitation runs (no gap between them).
-    auto add_edge = [&](const Run& fr, bool at_start) {
-      Edge e;
-      e.free_segment = seg_index;
-      e.at_start = at_start;
-      const std::size_t m = std::min<std::size_t>(kEdgeRows, fr.last - fr.first + 1);
-      double v = 0.0;
-      for (std::size_t j = 0; j < m; ++j) {
-        const std::size_t row = at_start ? fr.last - j : fr.first + j;
-        e.forced_rows.push_back(row);
-        v += pump ? std::abs((*pump)[row]) / static_cast<double>(m) : 1.0 / static_cast<double>(m);
-      }
-      e.pump_v = v;
-      const std::size_t run_rows = fr.last - fr.first + 1;
-      for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j)
-        e.slope_rows.push_back(at_start ? fr.last - j : fr.first + j);
-      if (m >= 4) d.edges.push_back(e);
-    };
-    if (ri > 0 && runs[ri - 1].exc && runs[ri - 1].last + 1 == r.first && !gap_before[r.first]) {
-      add_edge(runs[ri - 1], true);
-    }
-    if (ri + 1 < runs.size() && runs[ri + 1].exc && !gap_before[runs[ri + 1].first]) {
-      add_edge(runs[ri + 1], false);
-    }
-    ++seg_index;
+    const std::size_t len = runs[ri].last - runs[ri].first + 1;
+    if (runs[ri].exc && len >= kMinForcedSamples) add_forced_segment(r, runs[ri], dt, d);
+    if (!runs[ri].exc && len >= kMinFreeSamples) add_free_segment(r, runs, ri, nb, d);
   }
   // Hold out every fourth free segment (whole segments), when there are enough.
   if (d.free.size() >= 4) {

@@ -25,6 +25,7 @@ struct Block {
   double rate_rad_s = 0.0;
   double a2_v2 = 0.0;      // measured a_A^2
   double theta_rad = 0.0;  // measured pattern angle (continuous)
+  cplx rot;                // mean derotation phasor of the block (carries a constant offset)
 };
 
 struct FreeSegment {
@@ -76,6 +77,7 @@ struct Dataset {
   double angular_gain = 0.0;
   double noise_v = 0.0;  // per-sample, per-quadrature white noise
   double temp_ref_c = 0.0;
+  double t_mid_s = 0.0;  // middle of the recording: origin of the generic time terms
   bool has_temp = false, has_pump = false, has_rate = false;
   double temp_span_c = 0.0, a2_span_v2 = 0.0, rate_span_rad_s = 0.0;
   int samples_per_block = 1;

@@ -2,6 +2,7 @@
 #include "model.hpp"
 
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 
 #include "dsp/wave_variables.hpp"
@@ -19,8 +20,27 @@ Mat2 mul(const Mat2& a, const Mat2& b) {
 }
 
 struct Inputs {
-  double rate_rad_s, temp_c, a2_v2;
+  double rate_rad_s, temp_c, a2_v2, theta_rad, t_s;
 };
+
+bool any_of(const Params& p, std::initializer_list<int> idx) {
+  for (int i : idx)
+    if (p[static_cast<std::size_t>(i)] != 0.0) return true;
+  return false;
+}
+
+// Generic frequency (rad/s) and damping scale terms of the description.
+void generic_terms(const Params& p, const Dataset& d, const Inputs& in, double& dw, double& s) {
+  const double dT = in.temp_c - d.temp_ref_c;
+  const double a4 = in.a2_v2 * in.a2_v2;
+  const double th = (in.t_s - d.t_mid_s) / 3600.0;
+  const double c8 = std::cos(8.0 * in.theta_rad), s8 = std::sin(8.0 * in.theta_rad);
+  dw = 2.0 * kPi *
+       (p[kGFreqA4] * a4 + d.f_ref_hz * 1e-6 * p[kGFreqT2] * dT * dT + p[kGFreqTime] * th +
+        p[kGFreq8C] * c8 + p[kGFreq8S] * s8);
+  s = (1.0 + p[kGDampA4] * a4) * (1.0 + p[kGDampT2] * dT * dT) * (1.0 + p[kGDampTime] * th) *
+      (1.0 + p[kGDamp8C] * c8 + p[kGDamp8S] * s8);
+}
 
 // Dynamics matrix of the model for one set of slow inputs.
 Mat2 dynamics(const Params& p, const Dataset& d, const Inputs& in) {
@@ -30,16 +50,32 @@ Mat2 dynamics(const Params& p, const Dataset& d, const Inputs& in) {
   const double ok2 = in.rate_rad_s * p[kK] * in.rate_rad_s * p[kK];
   const double dw0 = p[kDw0] + p[kCor] * ok2 / (4.0 * kPi * d.f_ref_hz) +
                      2.0 * kPi * p[kDuff] * in.a2_v2 + 2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT;
-  const double s = (1.0 + p[kNld] * in.a2_v2) * (1.0 + p[kTd] * dT);
+  double s = (1.0 + p[kNld] * in.a2_v2) * (1.0 + p[kTd] * dT);
+  double dw = 0.0;
+  if (any_of(p, {kGFreqA4, kGDampA4, kGFreqT2, kGDampT2, kGFreqTime, kGDampTime, kGDamp8C, kGDamp8S,
+                 kGFreq8C, kGFreq8S})) {
+    double sg = 1.0;
+    generic_terms(p, d, in, dw, sg);
+    s *= sg;
+  }
   const double ok = in.rate_rad_s * p[kK];
-  return {kI * (dw0 + p[kDwC]) - s * (p[kNu] + p[kDnuC]), kI * p[kDwS] - s * p[kDnuS] + ok,
-          kI * p[kDwS] - s * p[kDnuS] - ok, kI * (dw0 - p[kDwC]) - s * (p[kNu] - p[kDnuC])};
+  return {kI * (dw0 + dw + p[kDwC]) - s * (p[kNu] + p[kDnuC]), kI * p[kDwS] - s * p[kDnuS] + ok,
+          kI * p[kDwS] - s * p[kDnuS] - ok, kI * (dw0 + dw - p[kDwC]) - s * (p[kNu] - p[kDnuC])};
 }
 
-// Pickoff chain: X_m = X, Y_m = (1+g) e^{-i phi} (Y cos2b + X sin2b).
-Mat2 pickoff(const Params& p) {
-  const cplx gy = (1.0 + p[kGain]) * std::polar(1.0, -p[kPhase]);
+// Pickoff chain: X_m = X, Y_m = (1+g) e^{-i phi} (Y cos2b + X sin2b), with
+// the generic drifts of g and phi in time and of g with temperature.
+Mat2 pickoff(const Params& p, double dgain = 0.0, double dphase = 0.0) {
+  const cplx gy = (1.0 + p[kGain] + dgain) * std::polar(1.0, -(p[kPhase] + dphase));
   return {1.0, 0.0, gy * std::sin(2.0 * p[kMis]), gy * std::cos(2.0 * p[kMis])};
+}
+
+bool pickoff_varies(const Params& p) { return any_of(p, {kGGainTime, kGPhaseTime, kGGainTemp}); }
+
+Mat2 pickoff_at(const Params& p, const Dataset& d, const Block& b) {
+  const double th = (b.t_s - d.t_mid_s) / 3600.0;
+  return pickoff(p, p[kGGainTime] * th + p[kGGainTemp] * (b.temp_c - d.temp_ref_c),
+                 p[kGPhaseTime] * th);
 }
 
 // Mean of exp(A tau) over the block's sample times (central moments m2..m4).
@@ -56,16 +92,17 @@ Mat2 block_mean(const Mat2& a, const Block& b) {
   return m;
 }
 
-Inputs inputs_of(const Block& b) { return {b.rate_rad_s, b.temp_c, b.a2_v2}; }
+Inputs inputs_of(const Block& b) { return {b.rate_rad_s, b.temp_c, b.a2_v2, b.theta_rad, b.t_s}; }
 Inputs mid_inputs(const Block& a, const Block& b) {
   return {0.5 * (a.rate_rad_s + b.rate_rad_s), 0.5 * (a.temp_c + b.temp_c),
-          0.5 * (a.a2_v2 + b.a2_v2)};
+          0.5 * (a.a2_v2 + b.a2_v2), 0.5 * (a.theta_rad + b.theta_rad), 0.5 * (a.t_s + b.t_s)};
 }
 
 // Block operators G_b = C M_b Phi_b of one segment.
 void segment_operators(const Dataset& d, const Params& p, const FreeSegment& s,
                        std::vector<Mat2>& g) {
-  const Mat2 c = pickoff(p);
+  const Mat2 c0 = pickoff(p);
+  const bool varies = pickoff_varies(p);
   g.resize(s.n_blocks);
   Mat2 phi{1.0, 0.0, 0.0, 1.0};
   for (std::size_t k = 0; k < s.n_blocks; ++k) {
@@ -74,13 +111,20 @@ void segment_operators(const Dataset& d, const Params& p, const FreeSegment& s,
       const Block& prev = d.blocks[s.first_block + k - 1];
       phi = mul(expm2(dynamics(p, d, mid_inputs(prev, b)), b.t_s - prev.t_s), phi);
     }
+    const Mat2 c = varies ? pickoff_at(p, d, b) : c0;
     g[k] = mul(c, mul(block_mean(dynamics(p, d, inputs_of(b)), b), phi));
   }
 }
 
+// Generic constant offsets of the x and y pickoffs (X = cx - i sx) as they
+// appear in the block means of the derotated envelopes.
+std::array<cplx, 2> offsets(const Params& p, const Block& b) {
+  return {cplx(p[kGOffXRe], p[kGOffXIm]) * b.rot, cplx(p[kGOffYRe], p[kGOffYIm]) * b.rot};
+}
+
 // Least-squares initial state over blocks [k0, k1).
-std::array<cplx, 2> solve_state(const Dataset& d, const FreeSegment& s, const std::vector<Mat2>& g,
-                                std::size_t k0, std::size_t k1) {
+std::array<cplx, 2> solve_state(const Dataset& d, const Params& p, const FreeSegment& s,
+                                const std::vector<Mat2>& g, std::size_t k0, std::size_t k1) {
   cplx n00 = 0, n01 = 0, n11 = 0, r0 = 0, r1 = 0;
   for (std::size_t k = k0; k < k1; ++k) {
     const Block& b = d.blocks[s.first_block + k];
@@ -89,8 +133,10 @@ std::array<cplx, 2> solve_state(const Dataset& d, const FreeSegment& s, const st
     n00 += b.n * (std::conj(m[0]) * m[0] + std::conj(m[2]) * m[2]);
     n01 += b.n * (std::conj(m[0]) * m[1] + std::conj(m[2]) * m[3]);
     n11 += b.n * (std::conj(m[1]) * m[1] + std::conj(m[3]) * m[3]);
-    r0 += b.n * (std::conj(m[0]) * b.x + std::conj(m[2]) * b.y);
-    r1 += b.n * (std::conj(m[1]) * b.x + std::conj(m[3]) * b.y);
+    const auto off = offsets(p, b);
+    const cplx bx = b.x - off[0], by = b.y - off[1];
+    r0 += b.n * (std::conj(m[0]) * bx + std::conj(m[2]) * by);
+    r1 += b.n * (std::conj(m[1]) * bx + std::conj(m[3]) * by);
   }
   const cplx n10 = std::conj(n01);
   const cplx det = n00 * n11 - n01 * n10;
@@ -109,8 +155,10 @@ double measured_phase(const Params& p, double theta) {
 }  // namespace
 
 double param_scale(int p) {
-  static constexpr double kScale[kParamCount] = {1e-3, 1e-3, 1e-4, 1e-4, 1e-4, 1e-4, 1e-3, 1e-3,
-                                                 1e-3, 1e-3, 1e-4, 1e-3, 1e-1, 1e-3, 1e-6, 1e-1};
+  static constexpr double kScale[kParamCount] = {
+      1e-3, 1e-3, 1e-4, 1e-4, 1e-4, 1e-4, 1e-3, 1e-3, 1e-3, 1e-3, 1e-4, 1e-3,
+      1e-1, 1e-3, 1e-6, 1e-1, 1e-4, 1e-3, 1e-1, 1e-3, 1e-4, 1e-2, 1e-3, 1e-3,
+      1e-5, 1e-5, 1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5, 1e-5, 1e-4};
   return kScale[p];
 }
 
@@ -139,7 +187,16 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
     const double okf = f.mean_rate_rad_s * p[kK];
     double w = p[kDw0] + p[kCor] * okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
                p[kDwS] * f.mean_s4 + 2.0 * kPi * p[kDuff] * f.mean_a2 +
-               2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT + 2.0 * kPi * p[kEs] * f.mean_v2;
+               2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT + 2.0 * kPi * p[kEs] * f.mean_v2 +
+               2.0 * kPi * p[kGFreqExc];
+    if (any_of(p, {kGFreqA4, kGFreqT2, kGFreqTime, kGFreq8C, kGFreq8S})) {
+      double dw = 0.0, sg = 1.0;
+      generic_terms(p, d,
+                    {f.mean_rate_rad_s, f.mean_temp_c, f.mean_a2,
+                     0.5 * (f.theta0_rad + f.theta1_rad), 0.5 * (f.t0_s + f.t1_s)},
+                    dw, sg);
+      w += dw;
+    }
     double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);
     dm = std::remainder(dm, kPi);
     w += dm / (f.t1_s - f.t0_s);
@@ -164,11 +221,12 @@ void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vect
       k_fit1 = std::max<std::size_t>(2, s.n_blocks / 5);
       k_res0 = k_fit1;
     }
-    const auto z = solve_state(d, s, g, 0, k_fit1);
+    const auto z = solve_state(d, p, s, g, 0, k_fit1);
     for (std::size_t k = k_res0; k < s.n_blocks; ++k) {
       const Block& b = d.blocks[s.first_block + k];
-      const cplx px = g[k][0] * z[0] + g[k][1] * z[1];
-      const cplx py = g[k][2] * z[0] + g[k][3] * z[1];
+      const auto off = offsets(p, b);
+      const cplx px = g[k][0] * z[0] + g[k][1] * z[1] + off[0];
+      const cplx py = g[k][2] * z[0] + g[k][3] * z[1] + off[1];
       const double w = std::sqrt(b.n) * inv_sigma;
       res.push_back(w * (b.x - px).real());
       res.push_back(w * (b.x - px).imag());
@@ -190,7 +248,7 @@ std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p,
   const FreeSegment& s = d.free[seg];
   std::vector<Mat2> g;
   segment_operators(d, p, s, g);
-  const auto z0 = solve_state(d, s, g, 0, s.n_blocks);
+  const auto z0 = solve_state(d, p, s, g, 0, s.n_blocks);
   // Propagate the state to the last block for rows after the segment.
   Mat2 phi{1.0, 0.0, 0.0, 1.0};
   for (std::size_t k = 1; k < s.n_blocks; ++k) {
@@ -218,7 +276,9 @@ std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p,
           dsp::wave_variables<double>({zx.real(), -zx.imag(), zy.real(), -zy.imag()}).theta_A_rad;
       *wave_phase_rad = std::arg(zx * std::cos(2.0 * th) + zy * std::sin(2.0 * th));
     }
-    out.push_back({c[0] * zx + c[1] * zy, c[2] * zx + c[3] * zy});
+    const cplx rot = std::polar(1.0, d.frame_phase_rad[rows[i]]);
+    out.push_back({c[0] * zx + c[1] * zy + cplx(p[kGOffXRe], p[kGOffXIm]) * rot,
+                   c[2] * zx + c[3] * zy + cplx(p[kGOffYRe], p[kGOffYIm]) * rot});
   }
   return out;
 }

@@ -36,8 +36,29 @@ enum Param : int {
   kEs,     // electrostatic_spring, Hz/V^2
   kCor,    // factor on the second-order Coriolis shift (Omega K)^2/2w: 1 for eq. 1;
            // fitted as a nuisance because first-order averaged simulators leave it out
+  // Generic terms of the description of what the catalogue cannot name
+  // (description.cpp); never a catalogue effect, never a calibration.
+  kGFreqA4,     // frequency per a_A^4, Hz/V^4
+  kGDampA4,     // damping scale per a_A^4, 1/V^4
+  kGFreqT2,     // frequency per (T - T0)^2, ppm/degC^2
+  kGDampT2,     // damping scale per (T - T0)^2, 1/degC^2
+  kGFreqTime,   // frequency drift, Hz/h (about the recording's middle)
+  kGDampTime,   // damping scale drift, 1/h
+  kGDamp8C,     // damping scale, cos 8 theta part
+  kGDamp8S,     // damping scale, sin 8 theta part
+  kGFreq8C,     // frequency, cos 8 theta part, Hz
+  kGFreq8S,     // frequency, sin 8 theta part, Hz
+  kGGainTime,   // y/x pickoff gain ratio drift, 1/h
+  kGPhaseTime,  // y pickoff phase drift, rad/h
+  kGGainTemp,   // y/x pickoff gain ratio per degC, 1/degC
+  kGOffXRe,     // additive offset of the x pickoff (cx_v), V
+  kGOffXIm,     // additive offset of the x pickoff (-sx_v), V
+  kGOffYRe,     // additive offset of the y pickoff (cy_v), V
+  kGOffYIm,     // additive offset of the y pickoff (-sy_v), V
+  kGFreqExc,    // frequency offset while the excitation is on, Hz
   kParamCount
 };
+inline constexpr int kFirstGeneric = kGFreqA4;
 
 using Params = std::array<double, kParamCount>;
 using Mask = std::array<bool, kParamCount>;

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "audit/audit.hpp"
 
@@ -31,59 +32,85 @@ std::string str(const std::string& s) {
   return o + "\"";
 }
 
+// A JSON array of the items, each written by `item`, one per line.
+template <typename T, typename F>
+std::string json_list(const std::vector<T>& items, F item) {
+  std::string j = "[";
+  for (std::size_t i = 0; i < items.size(); ++i)
+    j += std::string(i ? ",\n    " : "\n    ") + item(items[i]);
+  return j + (items.empty() ? "]" : "\n  ]");
+}
+
+std::string baseline_json(const AuditResult& r) {
+  const auto& b = r.baseline;
+  return "{\"params\": {\"f_hz\": " + num(b.f_hz) + ", \"q\": " + num(b.q) +
+         ", \"nu_per_s\": " + num(b.nu_per_s) + ", \"dmu\": " + num(b.dmu) +
+         ", \"theta_mu_deg\": " + num(b.theta_mu_deg) + ", \"split_hz\": " + num(b.split_hz) +
+         ", \"theta_w_deg\": " + num(b.theta_w_deg) + ", \"angular_gain\": " + num(b.angular_gain) +
+         "}, \"heldout_rms\": " + num(r.heldout_rms_v) +
+         ", \"fit_rms\": " + num(r.fit_rms_before_v) + ", \"noise_v\": " + num(r.noise_v) + "}";
+}
+
+std::string location_json(const Location& l) {
+  return "{\"signal\": " + str(l.signal) + ", \"where\": " + str(l.where) +
+         ", \"score\": " + num(l.score) + "}";
+}
+
+std::string finding_json(const Finding& f) {
+  const auto& info = effect_info(f.effect);
+  return "{\"effect\": " + str(info.id) + ", \"explanation\": " + str(info.explanation) +
+         ", \"params\": {" + str(info.param) + ": " + num(f.value) + "}, \"uncertainty\": {" +
+         str(info.param) + ": " + num(f.sigma) + "}, \"delta_bic\": " + num(f.delta_bic) +
+         ", \"heldout_rms_before\": " + num(f.heldout_rms_before_v) +
+         ", \"heldout_rms_after\": " + num(f.heldout_rms_after_v) +
+         ", \"explains_fraction\": " + num(f.explains_fraction < 0.0 ? NAN : f.explains_fraction) +
+         ", \"significance\": " + num(f.significance) + ", \"impact\": " + str(f.impact) + "}";
+}
+
+std::string alternative_json(const Alternative& a) {
+  const auto& info = effect_info(a.effect);
+  return "{\"effect\": " + str(info.id) + ", \"params\": {" + str(info.param) + ": " +
+         num(a.value) + "}, \"delta_bic\": " + num(a.delta_bic) + ", \"note\": " + str(a.note) +
+         "}";
+}
+
+std::string term_json(const DescriptionTerm& t) {
+  return "{\"term\": " + str(t.term) + ", \"text\": " + str(t.text) +
+         ", \"delta_bic\": " + num(t.delta_bic) +
+         ", \"explains_fraction\": " + num(t.explains_fraction) + "}";
+}
+
+// The description of what the catalogue cannot name, with the fit before and
+// after it (never a catalogue name, never written into a calibration).
+std::string description_json(const Description& d) {
+  return "{\"terms\": " + json_list(d.terms, term_json) +
+         ", \"fit_rms_before\": " + num(d.fit_rms_before_v) +
+         ", \"fit_rms_after\": " + num(d.fit_rms_after_v) +
+         ", \"heldout_rms_before\": " + num(d.heldout_rms_before_v) +
+         ", \"heldout_rms_after\": " + num(d.heldout_rms_after_v) + "}";
+}
+
+std::string candidate_json(const CandidateScore& c) {
+  return "{\"effect\": " + str(effect_info(c.effect).id) +
+         ", \"testable\": " + (c.testable ? "true" : "false") + ", \"value\": " + num(c.value) +
+         ", \"sigma\": " + num(c.sigma) + ", \"threshold\": " + num(c.threshold) +
+         ", \"delta_bic\": " + num(c.delta_bic) + "}";
+}
+
 }  // namespace
 
 std::string to_json(const AuditResult& r) {
   std::string j = "{\n  \"verdict\": " + str(r.verdict) + ",\n";
-  const auto& b = r.baseline;
-  j += "  \"baseline\": {\"params\": {\"f_hz\": " + num(b.f_hz) + ", \"q\": " + num(b.q) +
-       ", \"nu_per_s\": " + num(b.nu_per_s) + ", \"dmu\": " + num(b.dmu) +
-       ", \"theta_mu_deg\": " + num(b.theta_mu_deg) + ", \"split_hz\": " + num(b.split_hz) +
-       ", \"theta_w_deg\": " + num(b.theta_w_deg) + ", \"angular_gain\": " + num(b.angular_gain) +
-       "}, \"heldout_rms\": " + num(r.heldout_rms_v) + ", \"fit_rms\": " + num(r.fit_rms_before_v) +
-       ", \"noise_v\": " + num(r.noise_v) + "},\n";
-  j += "  \"locations\": [";
-  for (std::size_t i = 0; i < r.locations.size(); ++i) {
-    const auto& l = r.locations[i];
-    j += std::string(i ? ",\n    " : "\n    ") + "{\"signal\": " + str(l.signal) +
-         ", \"where\": " + str(l.where) + ", \"score\": " + num(l.score) + "}";
-  }
-  j += r.locations.empty() ? "],\n" : "\n  ],\n";
-  j += "  \"findings\": [";
-  for (std::size_t i = 0; i < r.findings.size(); ++i) {
-    const auto& f = r.findings[i];
-    const auto& info = effect_info(f.effect);
-    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(info.id) +
-         ", \"explanation\": " + str(info.explanation) + ", \"params\": {" + str(info.param) +
-         ": " + num(f.value) + "}, \"uncertainty\": {" + str(info.param) + ": " + num(f.sigma) +
-         "}, \"delta_bic\": " + num(f.delta_bic) +
-         ", \"heldout_rms_before\": " + num(f.heldout_rms_before_v) +
-         ", \"heldout_rms_after\": " + num(f.heldout_rms_after_v) +
-         ", \"impact\": " + str(f.impact) + "}";
-  }
-  j += r.findings.empty() ? "],\n" : "\n  ],\n";
-  j += "  \"alternatives\": [";
-  for (std::size_t i = 0; i < r.alternatives.size(); ++i) {
-    const auto& a = r.alternatives[i];
-    const auto& info = effect_info(a.effect);
-    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(info.id) +
-         ", \"params\": {" + str(info.param) + ": " + num(a.value) +
-         "}, \"delta_bic\": " + num(a.delta_bic) + ", \"note\": " + str(a.note) + "}";
-  }
-  j += r.alternatives.empty() ? "]" : "\n  ]";
+  j += "  \"baseline\": " + baseline_json(r) + ",\n";
+  j += "  \"locations\": " + json_list(r.locations, location_json) + ",\n";
+  j += "  \"findings\": " + json_list(r.findings, finding_json) + ",\n";
+  j += "  \"alternatives\": " + json_list(r.alternatives, alternative_json);
   if (!r.ambiguity_experiment.empty()) {
     j += ",\n  \"separating_experiment\": " + str(r.ambiguity_experiment);
   }
   if (!r.unexplained_note.empty()) j += ",\n  \"unexplained\": " + str(r.unexplained_note);
-  j += ",\n  \"candidates\": [";
-  for (std::size_t i = 0; i < r.candidates.size(); ++i) {
-    const auto& c = r.candidates[i];
-    j += std::string(i ? ",\n    " : "\n    ") + "{\"effect\": " + str(effect_info(c.effect).id) +
-         ", \"testable\": " + (c.testable ? "true" : "false") + ", \"value\": " + num(c.value) +
-         ", \"sigma\": " + num(c.sigma) + ", \"threshold\": " + num(c.threshold) +
-         ", \"delta_bic\": " + num(c.delta_bic) + "}";
-  }
-  j += r.candidates.empty() ? "]" : "\n  ]";
+  if (!r.description.terms.empty()) j += ",\n  \"description\": " + description_json(r.description);
+  j += ",\n  \"candidates\": " + json_list(r.candidates, candidate_json);
   j += ",\n  \"notes\": [";
   for (std::size_t i = 0; i < r.notes.size(); ++i)
     j += (i ? ", " : "") + str(r.notes[i]);
@@ -106,6 +133,13 @@ std::string to_text(const AuditResult& r, const std::string& source) {
     std::snprintf(buf, sizeof buf, "  FOUND %s: %s = %.4g +/- %.2g %s (delta BIC %.1f)\n", info.id,
                   info.param, f.value, f.sigma, info.unit, f.delta_bic);
     t += buf;
+    if (f.explains_fraction >= 0.0) {
+      std::snprintf(buf, sizeof buf,
+                    "    weight:  removes %.0f %% of the baseline's misfit beyond the noise, "
+                    "%.1f sigma from zero\n",
+                    100.0 * f.explains_fraction, f.significance);
+      t += buf;
+    }
     t += "    physics: " + std::string(info.explanation) + "\n";
     t += "    impact:  " + f.impact + "\n";
   }
@@ -118,7 +152,18 @@ std::string to_text(const AuditResult& r, const std::string& source) {
                   a.note.c_str());
     t += buf;
   }
-  if (!r.unexplained_note.empty()) t += "  UNEXPLAINED: " + r.unexplained_note + "\n";
+  if (!r.description.terms.empty()) {
+    t += "  UNEXPLAINED, described (not a catalogue effect; never a calibration):\n";
+    for (const auto& d : r.description.terms)
+      t += "    - " + d.text + "\n";
+    std::snprintf(buf, sizeof buf,
+                  "    fit: %.3g V -> %.3g V; held-out segments %.3g V -> %.3g V (noise %.3g V)\n",
+                  r.description.fit_rms_before_v, r.description.fit_rms_after_v,
+                  r.description.heldout_rms_before_v, r.description.heldout_rms_after_v, r.noise_v);
+    t += buf;
+  } else if (!r.unexplained_note.empty()) {
+    t += "  UNEXPLAINED: " + r.unexplained_note + "\n";
+  }
   t += "\nWhere the baseline misfits:\n";
   if (r.locations.empty()) t += "  nowhere above 5 sigma\n";
   for (const auto& l : r.locations) {

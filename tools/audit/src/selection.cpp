@@ -123,53 +123,33 @@ Eigen::Matrix4d feed_map(const EdgeJump& ej) {
   return ej.proj * m;
 }
 
-}  // namespace
+// A switch-off in the middle of a control transient is not evidence: edges
+// far outside the others are dropped (a real feedthrough, proportional to
+// the pump voltage, raises all of them together). Returns how many.
+int drop_transients(std::vector<EdgeJump>& jumps, std::vector<const Edge*>& used) {
+  std::vector<double> q;
+  for (const auto& ej : jumps)
+    q.push_back(ej.j.squaredNorm() / ej.var);
+  std::vector<double> qs(q);
+  std::nth_element(qs.begin(), qs.begin() + static_cast<std::ptrdiff_t>(qs.size() / 2), qs.end());
+  const double limit = std::max(30.0, 10.0 * qs[qs.size() / 2]);
+  std::vector<EdgeJump> kept;
+  std::vector<const Edge*> kept_edges;
+  for (std::size_t i = 0; i < jumps.size(); ++i) {
+    if (q[i] <= limit) kept.push_back(jumps[i]), kept_edges.push_back(used[i]);
+  }
+  const int dropped = static_cast<int>(jumps.size() - kept.size());
+  jumps.swap(kept);
+  used.swap(kept_edges);
+  return dropped;
+}
 
-FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
-  FeedStat fs;
-  if (d.edges.size() < 3) return fs;
-  std::vector<EdgeJump> jumps;
-  // Only the switch-offs: there the forces were steady and the free decay
-  // that follows is clean, while a control loop starting up makes the
-  // switch-ons transients that no low-order extrapolation follows.
-  std::vector<const Edge*> used;
-  for (const auto& e : d.edges) {
-    if (e.at_start) used.push_back(&e);
-  }
-  if (used.size() < 3) return fs;
-  for (const auto* e : used)
-    jumps.push_back(edge_jump(d, p, *e));
-  // A switch-off in the middle of a control transient is not evidence either:
-  // drop edges far outside the others (a real feedthrough, proportional to
-  // the pump voltage, raises all of them together).
-  {
-    std::vector<double> q;
-    for (const auto& ej : jumps)
-      q.push_back(ej.j.squaredNorm() / ej.var);
-    std::vector<double> qs(q);
-    std::nth_element(qs.begin(), qs.begin() + static_cast<std::ptrdiff_t>(qs.size() / 2), qs.end());
-    const double limit = std::max(30.0, 10.0 * qs[qs.size() / 2]);
-    std::vector<EdgeJump> kept;
-    std::vector<const Edge*> kept_edges;
-    for (std::size_t i = 0; i < jumps.size(); ++i) {
-      if (q[i] <= limit) kept.push_back(jumps[i]), kept_edges.push_back(used[i]);
-    }
-    fs.dropped = static_cast<int>(jumps.size() - kept.size());
-    jumps.swap(kept);
-    used.swap(kept_edges);
-    if (jumps.size() < 3) return fs;
-  }
-  if (std::getenv("HRG_AUDIT_DEBUG")) {
-    for (std::size_t i = 0; i < jumps.size(); ++i) {
-      std::fprintf(stderr, "edge %zu t=%.3f |J|/sd=%.2f V=%.2f J=%s\n", i,
-                   d.t_s[used[i]->forced_rows[0]], jumps[i].j.norm() / std::sqrt(jumps[i].var),
-                   jumps[i].pump_v,
-                   fmt("%.2e %.2e %.2e", jumps[i].j(0), jumps[i].j(1), jumps[i].j(2)).c_str());
-    }
-  }
+// Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
+// (the wave phase is defined modulo pi), minus its noise expectation. Fills
+// dchi2 and threshold; returns the mean of w^2 per pickoff.
+std::array<cplx, 2> sign_free_detection(const std::vector<EdgeJump>& jumps, double ln_neff,
+                                        FeedStat& fs) {
   const auto n = static_cast<double>(jumps.size());
-  // Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
-  // (the wave phase is defined modulo pi), minus its noise expectation.
   std::array<cplx, 2> m{};
   double s4 = 0.0;
   for (const auto& ej : jumps) {
@@ -188,50 +168,89 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   }
   const double var_m = 2.0 * s4 / n;
   fs.dchi2 = 2.0 * (std::norm(m[0]) + std::norm(m[1])) / var_m;
-  fs.testable = true;
-  fs.edges = static_cast<int>(n);
   fs.threshold = std::pow(4.0 * ln_neff * s4 / n, 0.25);
-  // Estimate: least squares, first with the sign the wave phase convention
-  // gives, then with one sign per edge (for a source whose drive phase flips
-  // by pi with another convention); the free signs are taken only when they
-  // fit much better than the freedom they add.
-  auto solve = [&](bool free_signs, Vec4 c, double& cost, double& sigma) {
-    for (int it = 0; it < (free_signs ? 5 : 1); ++it) {
-      Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
-      Vec4 rhs = Vec4::Zero();
-      for (const auto& ej : jumps) {
-        const Eigen::Matrix4d f = feed_map(ej);
-        const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
-        a += f.transpose() * f / ej.var;
-        rhs += sgn * f.transpose() * ej.j / ej.var;
-      }
-      c = a.ldlt().solve(rhs);
-      cost = 0.0;
-      for (const auto& ej : jumps) {
-        const Eigen::Matrix4d f = feed_map(ej);
-        const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
-        cost += (ej.j - sgn * f * c).squaredNorm() / ej.var;
-      }
-      // Scaled by the scatter of the edges about the fit when it exceeds the
-      // noise (extrapolation errors the noise alone does not cover).
-      const Eigen::Matrix4d cov = a.inverse();
-      const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
-      sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0 *
-                        std::max(1.0, cost / dof));
+  return m;
+}
+
+// Least-squares feedthrough c (re/im c_x, re/im c_y) over the edges, with the
+// sign the wave phase convention gives or (free_signs) one sign per edge,
+// iterated from `c`. Its cost and the 1-sigma of the larger |c_k|, scaled by
+// the scatter of the edges about the fit when it exceeds the noise
+// (extrapolation errors the noise alone does not cover).
+Vec4 solve_feedthrough(const std::vector<EdgeJump>& jumps, bool free_signs, Vec4 c, double& cost,
+                       double& sigma) {
+  for (int it = 0; it < (free_signs ? 5 : 1); ++it) {
+    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+    Vec4 rhs = Vec4::Zero();
+    for (const auto& ej : jumps) {
+      const Eigen::Matrix4d f = feed_map(ej);
+      const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
+      a += f.transpose() * f / ej.var;
+      rhs += sgn * f.transpose() * ej.j / ej.var;
     }
-    return c;
-  };
+    c = a.ldlt().solve(rhs);
+    cost = 0.0;
+    for (const auto& ej : jumps) {
+      const Eigen::Matrix4d f = feed_map(ej);
+      const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
+      cost += (ej.j - sgn * f * c).squaredNorm() / ej.var;
+    }
+    const Eigen::Matrix4d cov = a.inverse();
+    const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
+    sigma = std::sqrt(std::max(cov(0, 0) + cov(1, 1), cov(2, 2) + cov(3, 3)) / 2.0 *
+                      std::max(1.0, cost / dof));
+  }
+  return c;
+}
+
+void debug_edges(const Dataset& d, const std::vector<EdgeJump>& jumps,
+                 const std::vector<const Edge*>& used) {
+  for (std::size_t i = 0; i < jumps.size(); ++i) {
+    std::fprintf(stderr, "edge %zu t=%.3f |J|/sd=%.2f V=%.2f J=%s\n", i,
+                 d.t_s[used[i]->forced_rows[0]], jumps[i].j.norm() / std::sqrt(jumps[i].var),
+                 jumps[i].pump_v,
+                 fmt("%.2e %.2e %.2e", jumps[i].j(0), jumps[i].j(1), jumps[i].j(2)).c_str());
+  }
+}
+
+}  // namespace
+
+FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
+  FeedStat fs;
+  // Only the switch-offs: there the forces were steady and the free decay
+  // that follows is clean, while a control loop starting up makes the
+  // switch-ons transients that no low-order extrapolation follows.
+  std::vector<const Edge*> used;
+  for (const auto& e : d.edges) {
+    if (e.at_start) used.push_back(&e);
+  }
+  if (d.edges.size() < 3 || used.size() < 3) return fs;
+  std::vector<EdgeJump> jumps;
+  for (const auto* e : used)
+    jumps.push_back(edge_jump(d, p, *e));
+  fs.dropped = drop_transients(jumps, used);
+  if (jumps.size() < 3) return fs;
+  const bool debug = std::getenv("HRG_AUDIT_DEBUG") != nullptr;
+  if (debug) debug_edges(d, jumps, used);
+  const std::array<cplx, 2> m = sign_free_detection(jumps, ln_neff, fs);
+  fs.testable = true;
+  fs.edges = static_cast<int>(jumps.size());
+  // Estimate: first with the sign the wave phase convention gives, then with
+  // one sign per edge (for a source whose drive phase flips by pi with
+  // another convention); the free signs are taken only when they fit much
+  // better than the freedom they add.
   double fixed_cost = 0.0, fixed_sigma = 0.0;
-  Vec4 best_c = solve(false, Vec4::Zero(), fixed_cost, fixed_sigma);
+  Vec4 best_c = solve_feedthrough(jumps, false, Vec4::Zero(), fixed_cost, fixed_sigma);
   fs.sigma = fixed_sigma;
   double best_cost = 1e300, best_sigma = 0.0;
   Vec4 free_c = Vec4::Zero();
   for (double rel : {1.0, -1.0}) {
     double cost = 0.0, sigma = 0.0;
-    const Vec4 c = solve(true, real4({std::sqrt(m[0]), rel * std::sqrt(m[1])}), cost, sigma);
+    const Vec4 c = solve_feedthrough(jumps, true, real4({std::sqrt(m[0]), rel * std::sqrt(m[1])}),
+                                     cost, sigma);
     if (cost < best_cost) best_cost = cost, free_c = c, best_sigma = sigma;
   }
-  if (std::getenv("HRG_AUDIT_DEBUG")) {
+  if (debug) {
     std::fprintf(
         stderr, "feedthrough: fixed-sign cost %.1f |c| %.3g, free-sign cost %.1f |c| %.3g\n",
         fixed_cost, std::max(std::hypot(best_c(0), best_c(1)), std::hypot(best_c(2), best_c(3))),
@@ -247,57 +266,54 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
 }
 
 double effective_fraction(const std::vector<double>& res, std::size_t n_free_res) {
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i + 4 < n_free_res; ++i)
-    num += res[i] * res[i + 4];
+  // Integrated autocorrelation time of the block residuals (lags in blocks,
+  // 4 residuals per block), summed over pairs of lags while the pair sum stays
+  // positive: slow coloured noise (1/f-like) keeps the correlation up over
+  // many blocks, and its samples count for less than white ones. For an AR(1)
+  // residual this is (1 - rho)/(1 + rho).
+  n_free_res = std::min(n_free_res, res.size());
+  double den = 0.0;
   for (std::size_t i = 0; i < n_free_res; ++i)
     den += res[i] * res[i];
   if (den <= 0.0) return 1.0;
-  const double rho = num / den;
-  if (rho <= 0.0) return 1.0;
-  return std::clamp((1.0 - rho) / (1.0 + rho), 0.02, 1.0);
+  auto rho = [&](std::size_t lag) {
+    double num = 0.0;
+    for (std::size_t i = 0; i + 4 * lag < n_free_res; ++i)
+      num += res[i] * res[i + 4 * lag];
+    return num / den;
+  };
+  const std::size_t max_lag = std::min<std::size_t>(64, n_free_res / 40);
+  double tau = 1.0;
+  const double r1 = rho(1);
+  if (r1 <= 0.0) return 1.0;
+  tau += 2.0 * r1;
+  for (std::size_t lag = 2; lag + 1 <= max_lag; lag += 2) {
+    const double pair = rho(lag) + rho(lag + 1);
+    if (pair <= 0.0) break;
+    tau += 2.0 * pair;
+  }
+  return std::clamp(1.0 / tau, 0.02, 1.0);
 }
 
-std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
-                             bool use_forced, const FeedStat& ft) {
-  std::vector<Location> out;
-  // Per free segment: excess chi^2 over its degrees of freedom.
-  std::size_t k = 0;
+namespace {
+
+// Free segments whose excess chi^2 over their degrees of freedom stands out
+// (up to three, above 5 sigma).
+void locate_segments(const Dataset& d, const std::vector<double>& res, std::vector<Location>& out) {
   struct SegScore {
     double excess;
     std::size_t i;
   };
   std::vector<SegScore> segs;
-  // Harmonics of the amplitude and quadrature residuals against 4 theta.
-  double sa[3][3] = {}, sq[3][3] = {};
-  double ya[3] = {}, yq[3] = {};
-  std::vector<std::array<cplx, 2>> pred;
-  std::vector<double> tmp;
-  evaluate(d, p, EvalOptions{}, tmp, &pred);
+  std::size_t k = 0;
   for (std::size_t si = 0; si < d.free.size(); ++si) {
     const auto& s = d.free[si];
     double chi = 0.0;
     for (std::size_t b = 0; b < s.n_blocks && k + 3 < res.size(); ++b, k += 4) {
       chi += res[k] * res[k] + res[k + 1] * res[k + 1] + res[k + 2] * res[k + 2] +
              res[k + 3] * res[k + 3];
-      const Block& bl = d.blocks[s.first_block + b];
-      const auto& pr = pred[s.first_block + b];
-      const auto wm =
-          dsp::wave_variables<double>({bl.x.real(), -bl.x.imag(), bl.y.real(), -bl.y.imag()});
-      const auto wp =
-          dsp::wave_variables<double>({pr[0].real(), -pr[0].imag(), pr[1].real(), -pr[1].imag()});
-      const double sig = d.noise_v / std::sqrt(bl.n);
-      const double da = (wm.a_A - wp.a_A) / sig;
-      const double dq = (wm.a_B - wp.a_B) / sig;
-      const double f[3] = {1.0, std::cos(4.0 * bl.theta_rad), std::sin(4.0 * bl.theta_rad)};
-      for (int i = 0; i < 3; ++i) {
-        ya[i] += f[i] * da, yq[i] += f[i] * dq;
-        for (int j = 0; j < 3; ++j)
-          sa[i][j] += f[i] * f[j], sq[i][j] += f[i] * f[j];
-      }
     }
-    const double dof = 4.0 * static_cast<double>(s.n_blocks);
-    segs.push_back({chi - dof, si});
+    segs.push_back({chi - 4.0 * static_cast<double>(s.n_blocks), si});
   }
   std::sort(segs.begin(), segs.end(), [](auto a, auto b) { return a.excess > b.excess; });
   for (std::size_t i = 0; i < std::min<std::size_t>(3, segs.size()); ++i) {
@@ -308,8 +324,21 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
                    fmt("free decay %.2f-%.2f s", s.t0_s, s.t1_s) + rate_note(d, s),
                    segs[i].excess});
   }
-  // 4-theta harmonic explained chi^2 (projection onto cos4, sin4 after the mean).
-  auto harmonic = [](double s[3][3], double y[3]) {
+}
+
+// Normal equations of a fit on {1, cos 4theta, sin 4theta}.
+struct Harmonic3 {
+  double s[3][3] = {};
+  double y[3] = {};
+  void add(const double f[3], double v) {
+    for (int i = 0; i < 3; ++i) {
+      y[i] += f[i] * v;
+      for (int j = 0; j < 3; ++j)
+        s[i][j] += f[i] * f[j];
+    }
+  }
+  // chi^2 explained by the 4-theta harmonic beyond the mean, and its cos/sin.
+  std::array<double, 3> solve() const {
     Eigen::Matrix3d a;
     Eigen::Vector3d b;
     for (int i = 0; i < 3; ++i) {
@@ -321,42 +350,75 @@ std::vector<Location> locate(const Dataset& d, const Params& p, const std::vecto
     const Eigen::Vector3d c = a.ldlt().solve(b);
     const double explained = b.dot(c) - y[0] * y[0] / std::max(s[0][0], 1e-30);
     return std::array<double, 3>{explained, c(1), c(2)};
-  };
-  const auto ha = harmonic(sa, ya);
-  const auto hq = harmonic(sq, yq);
-  const double sig1 = d.noise_v;
-  if (ha[0] > 25.0) {
-    const double amp = std::hypot(ha[1], ha[2]);
-    out.push_back({"a_A (measured amplitude)",
-                   fmt("4-theta harmonic of the amplitude residual, %.3g V at 4theta = %.0f deg",
-                       amp * sig1, std::atan2(ha[2], ha[1]) * 180.0 / kPi),
-                   ha[0]});
   }
-  if (hq[0] > 25.0) {
-    const double amp = std::hypot(hq[1], hq[2]);
-    out.push_back({"a_B (quadrature)",
-                   fmt("4-theta harmonic of the quadrature residual, %.3g V at 4theta = %.0f deg",
-                       amp * sig1, std::atan2(hq[2], hq[1]) * 180.0 / kPi),
-                   hq[0]});
-  }
-  // Excitation segments: mean frequency offset while the pump is on.
-  if (use_forced && !d.forced.empty()) {
-    const auto fr = forced_residuals(d, p);
-    double m = 0.0, v2 = 0.0, wsum = 0.0;
-    for (std::size_t i = 0; i < fr.size(); ++i) {
-      const double w = 1.0 / (d.forced[i].sigma_rad_s * d.forced[i].sigma_rad_s);
-      m += w * fr[i], v2 += d.forced[i].mean_v2 / static_cast<double>(fr.size()), wsum += w;
-    }
-    m /= wsum;
-    const double chi = m * m * wsum;
-    if (chi > 25.0) {
-      out.push_back({"wave frequency",
-                     fmt("excitation segments (pump on, mean pump_v^2 %.3g V^2): %.3g mHz "
-                         "off the free-decay frequency",
-                         v2, m / (2.0 * kPi) * 1e3),
-                     chi});
+};
+
+// 4-theta harmonics of the amplitude and quadrature residuals.
+void locate_harmonics(const Dataset& d, const Params& p, const std::vector<double>& res,
+                      std::vector<Location>& out) {
+  Harmonic3 ha, hq;
+  std::vector<std::array<cplx, 2>> pred;
+  std::vector<double> tmp;
+  evaluate(d, p, EvalOptions{}, tmp, &pred);
+  std::size_t k = 0;
+  for (const auto& s : d.free) {
+    for (std::size_t b = 0; b < s.n_blocks && k + 3 < res.size(); ++b, k += 4) {
+      const Block& bl = d.blocks[s.first_block + b];
+      const auto& pr = pred[s.first_block + b];
+      const auto wm =
+          dsp::wave_variables<double>({bl.x.real(), -bl.x.imag(), bl.y.real(), -bl.y.imag()});
+      const auto wp =
+          dsp::wave_variables<double>({pr[0].real(), -pr[0].imag(), pr[1].real(), -pr[1].imag()});
+      const double sig = d.noise_v / std::sqrt(bl.n);
+      const double f[3] = {1.0, std::cos(4.0 * bl.theta_rad), std::sin(4.0 * bl.theta_rad)};
+      ha.add(f, (wm.a_A - wp.a_A) / sig);
+      hq.add(f, (wm.a_B - wp.a_B) / sig);
     }
   }
+  const struct {
+    std::array<double, 3> h;
+    const char* signal;
+    const char* what;
+  } parts[] = {{ha.solve(), "a_A (measured amplitude)", "amplitude"},
+               {hq.solve(), "a_B (quadrature)", "quadrature"}};
+  for (const auto& part : parts) {
+    if (part.h[0] <= 25.0) continue;
+    const double amp = std::hypot(part.h[1], part.h[2]);
+    out.push_back({part.signal,
+                   std::string("4-theta harmonic of the ") + part.what +
+                       fmt(" residual, %.3g V at 4theta = %.0f deg", amp * d.noise_v,
+                           std::atan2(part.h[2], part.h[1]) * 180.0 / kPi),
+                   part.h[0]});
+  }
+}
+
+// Excitation segments: mean frequency offset while the pump is on.
+void locate_forced(const Dataset& d, const Params& p, std::vector<Location>& out) {
+  const auto fr = forced_residuals(d, p);
+  double m = 0.0, v2 = 0.0, wsum = 0.0;
+  for (std::size_t i = 0; i < fr.size(); ++i) {
+    const double w = 1.0 / (d.forced[i].sigma_rad_s * d.forced[i].sigma_rad_s);
+    m += w * fr[i], v2 += d.forced[i].mean_v2 / static_cast<double>(fr.size()), wsum += w;
+  }
+  m /= wsum;
+  const double chi = m * m * wsum;
+  if (chi > 25.0) {
+    out.push_back({"wave frequency",
+                   fmt("excitation segments (pump on, mean pump_v^2 %.3g V^2): %.3g mHz "
+                       "off the free-decay frequency",
+                       v2, m / (2.0 * kPi) * 1e3),
+                   chi});
+  }
+}
+
+}  // namespace
+
+std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
+                             bool use_forced, const FeedStat& ft) {
+  std::vector<Location> out;
+  locate_segments(d, res, out);
+  locate_harmonics(d, p, res, out);
+  if (use_forced && !d.forced.empty()) locate_forced(d, p, out);
   if (ft.testable && ft.dchi2 > 25.0) {
     out.push_back({"cx_v,sx_v,cy_v,sy_v",
                    fmt("switching instants of exc (%.0f edges): steps of %.3g V/V of pump "

@@ -49,6 +49,19 @@ struct AuditOptions {
   // Residual variance over high-frequency noise variance above which the
   // remaining structure is called unexplained.
   double unexplained_ratio = 1.5;
+  // A catalogue finding must stand this many of its standard deviations away
+  // from zero and, with structure left, remove at least this share of the
+  // baseline's misfit.
+  double min_significance = 5.0;
+  double min_explains_fraction = 0.2;
+  // Evidence for a generic description term (delta BIC): a search over many
+  // shapes needs more than one catalogue candidate.
+  double min_description_bic = 20.0;
+  // A description term must lower the mean-square residual per sample by at
+  // least this share of the noise variance (its slow part included):
+  // smaller structure is not described (it stays in the locations).
+  double min_description_share = 0.1;
+  int max_description_terms = 3;
 };
 
 struct Location {
@@ -64,7 +77,28 @@ struct Finding {
   double delta_bic = 0.0;
   double heldout_rms_before_v = 0.0;
   double heldout_rms_after_v = 0.0;
-  std::string impact;  // in gyro units
+  // Share of the baseline's misfit beyond the noise (chi^2 - n) that this
+  // effect alone removes given everything else accepted (drop-one refit).
+  double explains_fraction = 0.0;
+  double significance = 0.0;  // |value| / sigma
+  std::string impact;         // in gyro units
+};
+
+// One term of the generic description of structure no catalogue effect names.
+struct DescriptionTerm {
+  std::string term;  // generic shape, e.g. gain_ratio_drift (never a catalogue id)
+  std::string text;  // plain words and numbers
+  double delta_bic = 0.0;
+  double explains_fraction = 0.0;
+};
+
+// What the catalogue cannot name, described (verdict `unexplained`).
+struct Description {
+  std::vector<DescriptionTerm> terms;
+  double fit_rms_before_v = 0.0;  // catalogue model, all free-decay samples
+  double fit_rms_after_v = 0.0;   // with the description
+  double heldout_rms_before_v = 0.0;
+  double heldout_rms_after_v = 0.0;
 };
 
 struct Alternative {
@@ -111,6 +145,7 @@ struct AuditResult {
   std::vector<Finding> findings;
   std::vector<Alternative> alternatives;
   std::vector<CandidateScore> candidates;
+  Description description;  // empty unless structure is left that the catalogue cannot name
   std::string ambiguity_experiment;
   std::string unexplained_note;
   std::vector<std::string> notes;  // gaps, skipped tests, ...

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: MIT
+// The audit beyond one catalogue effect: structure outside the catalogue is
+// described and never named, two effects at once are both found, slow
+// coloured noise is not structure, and a reference that follows the
+// resonance is read as such (slow: each is a full audit).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "audit/audit.hpp"
+#include "../../tools/audit/src/campaign.hpp"
+
+#include "support/cpputest.hpp"
+
+namespace bench = hrg::audit::bench;
+using hrg::audit::AuditResult;
+using hrg::audit::Effect;
+
+namespace {
+
+constexpr uint64_t kSeed = 100006;
+
+bench::Scenario ringdown() { return bench::random_scenario(bench::Design::ringdown, 300.0, kSeed); }
+
+double threshold_of(const AuditResult& r, Effect e) {
+  for (const auto& c : r.candidates) {
+    if (c.effect == e && c.testable) return c.threshold;
+  }
+  return 0.0;
+}
+
+const hrg::audit::Finding* finding_of(const AuditResult& r, Effect e) {
+  const auto it = std::find_if(r.findings.begin(), r.findings.end(),
+                               [&](const hrg::audit::Finding& f) { return f.effect == e; });
+  return it == r.findings.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+TEST_GROUP(AuditBeyondCatalogue){};
+
+TEST(AuditBeyondCatalogue, GainRatioDriftIsDescribedNeverNamed) {
+  // GIVEN a ring-down campaign whose y pickoff gain drifts by 40 x the
+  // relative noise over the recording (no catalogue effect holds a drift)
+  bench::Scenario s = ringdown();
+  s.outside = bench::OutsideEffect::gain_ratio_drift;
+  const double drift_per_h = 40.0 * s.noise_v / s.amplitude_v / (s.duration_s / 3600.0);
+  s.outside_value = drift_per_h;
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "gain drift");
+  // THEN the verdict is unexplained with a description and no catalogue name
+  STRCMP_EQUAL_TEXT("unexplained", r.verdict.c_str(), text.c_str());
+  LONGS_EQUAL_TEXT(0, r.findings.size(), text.c_str());
+  CHECK_TEXT(!r.description.terms.empty(), text.c_str());
+  STRCMP_EQUAL("gain_ratio_drift", r.description.terms.front().term.c_str());
+  // AND the description reproduces the structure: held-out residual within
+  // 1.2x the noise, and it says the drift per hour in words and numbers.
+  CHECK_TEXT(r.description.heldout_rms_after_v < 1.2 * r.noise_v, text.c_str());
+  CHECK(r.description.heldout_rms_before_v > 1.5 * r.noise_v);
+  CHECK(r.description.terms.front().text.find("per hour") != std::string::npos);
+  // AND the JSON carries it
+  CHECK(hrg::audit::to_json(r).find("\"description\"") != std::string::npos);
+}
+
+TEST(AuditBeyondCatalogue, TwoEffectsAtOnceAreBothFound) {
+  // GIVEN the null twin's thresholds, a pickoff gain mismatch and a Duffing
+  // term at 2.5x theirs concealed together
+  const bench::Scenario base = ringdown();
+  const AuditResult null = hrg::audit::run_audit(bench::simulate(base));
+  STRCMP_EQUAL("consistent", null.verdict.c_str());
+  const double gain = 2.5 * threshold_of(null, Effect::pickoff_gain_mismatch);
+  const double duff = -2.5 * threshold_of(null, Effect::duffing_stiffness);
+  bench::Scenario s = base;
+  CHECK(bench::conceal_by_id(s, "pickoff_gain_mismatch", gain, kSeed));
+  CHECK(bench::conceal_by_id(s, "duffing_stiffness", duff, kSeed));
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "pair");
+  // THEN both are findings with their parameters within 20 %, each carrying
+  // a real share of the misfit and standing far from zero.
+  const auto* g = finding_of(r, Effect::pickoff_gain_mismatch);
+  const auto* d = finding_of(r, Effect::duffing_stiffness);
+  CHECK_TEXT(g != nullptr && d != nullptr, text.c_str());
+  DOUBLES_EQUAL(gain, g->value, 0.2 * std::abs(gain));
+  DOUBLES_EQUAL(duff, d->value, 0.2 * std::abs(duff));
+  CHECK(g->significance >= 5.0 && d->significance >= 5.0);
+  CHECK(g->explains_fraction > 0.0 && d->explains_fraction > 0.0);
+}
+
+TEST(AuditBeyondCatalogue, SlowColouredNoiseIsNotStructure) {
+  // GIVEN the null campaign with 1/f noise on every demodulated signal whose
+  // density equals the white noise's at 1.5 Hz
+  bench::Scenario s = ringdown();
+  s.flicker_corner_hz = 1.5;
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  // THEN nothing is found and nothing is described
+  STRCMP_EQUAL_TEXT("consistent", r.verdict.c_str(), hrg::audit::to_text(r, "1/f").c_str());
+}
+
+TEST(AuditBeyondCatalogue, ReferenceFollowingTheResonanceIsRead) {
+  // GIVEN the envelopes against a reference that pulls in to the resonance
+  // and wanders by mHz around it (f_ref_hz per row)
+  bench::Scenario base = ringdown();
+  base.pll_reference = true;
+  const AuditResult null = hrg::audit::run_audit(bench::simulate(base));
+  // THEN the null is consistent and the baseline frequency is the resonance's
+  STRCMP_EQUAL_TEXT("consistent", null.verdict.c_str(), hrg::audit::to_text(null, "pll").c_str());
+  DOUBLES_EQUAL(base.resonator.f_hz, null.baseline.f_hz, 1e-3);
+  // AND a phase mismatch at 3x threshold is found within 20 %
+  const double phase = 3.0 * threshold_of(null, Effect::pickoff_phase_mismatch);
+  bench::Scenario s = base;
+  CHECK(bench::conceal_by_id(s, "pickoff_phase_mismatch", phase, kSeed));
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  CHECK_TEXT(!r.findings.empty(), hrg::audit::to_text(r, "pll phase").c_str());
+  CHECK(r.findings.front().effect == Effect::pickoff_phase_mismatch);
+  DOUBLES_EQUAL(phase, r.findings.front().value, 0.2 * std::abs(phase));
+}
