@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "characterize/datasheet.hpp"
 #include "characterize/noise_terms.hpp"
 #include "sim_tools/json.hpp"
 
@@ -30,10 +31,7 @@ inline void numbers(simtools::JsonWriter& w, std::string_view key, const std::ve
   w.end_array();
 }
 
-struct Series {
-  std::string label, style;  // style: "line", "points", "errorbar"
-  std::vector<double> x, y, lo, hi;
-};
+using Series = SheetSeries;
 
 inline void plot(simtools::JsonWriter& w, std::string_view id, std::string_view title,
                  std::string_view x_label, std::string_view y_label, bool log_x, bool log_y,

@@ -14,6 +14,28 @@
 
 namespace hrg::characterize {
 
+// Pieces of a section that a caller assembles itself (a test procedure's
+// measured figures): figures, data tables and plots, as in the JSON below.
+struct SheetFigure {
+  std::string name;
+  double value = 0.0, lo = 0.0, hi = 0.0, sigma = 0.0;  // NaN: not stated (null)
+  std::string unit, note;
+};
+struct SheetTable {
+  std::string title;
+  std::vector<std::string> columns;
+  std::vector<std::vector<std::string>> rows;
+};
+struct SheetSeries {
+  std::string label, style;  // style: "line", "points", "errorbar"
+  std::vector<double> x, y, lo, hi;
+};
+struct SheetPlot {
+  std::string id, title, x_label, y_label;
+  bool log_x = false, log_y = false;
+  std::vector<SheetSeries> series;
+};
+
 // The data sheet as JSON: {"title", "sections": [section...]}, each section
 //   {"id", "title", "standard", "figures": [{"name", "value", "lo", "hi",
 //    "sigma", "unit", "note"}], "tables": [{"title", "columns", "rows"}],
@@ -43,6 +65,10 @@ class DataSheet {
     std::string note;  // where the figures come from (closed form, measured)
   };
   void limits(const Limits& l);
+  // A section assembled by the caller.
+  void section(std::string_view id, std::string_view title, std::string_view standard,
+               std::span<const SheetFigure> figures, std::span<const SheetTable> tables,
+               std::span<const SheetPlot> plots);
 
   // The whole document; the writer is closed by this call.
   std::string finish();
