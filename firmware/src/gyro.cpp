@@ -6,7 +6,7 @@
 
 namespace hrg::fw {
 
-Gyro::Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier,
+Gyro::Gyro(hal::Board& board, SignalChain& chain, ResonatorIdentifier& identifier,
            hal::MonotonicClock& timer, Pacing pacing, const GyroConfig& cfg)
     : board_(board),
       chain_(chain),
@@ -347,7 +347,7 @@ void Gyro::apply(const can::Command& c) {
     case can::Cmd::ident:
       cfg_.identify = c.ident_start;
       // A new campaign from scratch (no heap: the scheduler is rebuilt in place).
-      if (c.ident_start) scheduler_ = ShutdownScheduler(cfg_.windows);
+      if (c.ident_start) scheduler_ = WindowScheduler(cfg_.windows);
       break;
     case can::Cmd::window:
       cfg_.windows.period_frames = static_cast<uint32_t>(c.window_period_s * kBaseRateHz + 0.5);

@@ -135,7 +135,7 @@ TEST(DspChainPort, TheGyroRefusesAnUnusableChainAndKeepsTheDrivesOff) {
   DspChainPort port(c);
   hrg::fakes::FakeBoard b;
   hrg::fakes::FakeClock timer;
-  hrg::fakes::FakeIdentifier ident;
+  hrg::fakes::FakeResonatorIdentifier ident;
   hrg::fw::Gyro g(b.board, port, ident, timer, hrg::fw::Pacing::lockstep, hrg::fw::GyroConfig{});
   CHECK_FALSE(g.board_ok());
   STRCMP_CONTAINS("pump_max_v", g.chain_error());

@@ -106,10 +106,10 @@ TEST(FakeChain, MovesThePatternTowardsTheTarget) {
   DOUBLES_EQUAL(0.2, c.theta(), 1e-12);
 }
 
-TEST_GROUP(FakeIdentifier){};
+TEST_GROUP(FakeResonatorIdentifier){};
 
-TEST(FakeIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsItsBackDoorValues) {
-  hrg::fakes::FakeIdentifier id;
+TEST(FakeResonatorIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsItsBackDoorValues) {
+  hrg::fakes::FakeResonatorIdentifier id;
   hrg::fw::ChainRecord s;
   id.add_sample(s);  // outside a window: not counted
   id.begin_window(1.5);

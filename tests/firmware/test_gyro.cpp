@@ -39,7 +39,7 @@ GyroConfig test_config() {
 TEST_GROUP(Gyro) {
   hrg::fakes::FakeBoard b;
   hrg::fakes::FakeChain chain;
-  hrg::fakes::FakeIdentifier ident;
+  hrg::fakes::FakeResonatorIdentifier ident;
   hrg::fakes::FakeClock timer;
 
   void run(Gyro & g, int frames) {

@@ -56,7 +56,7 @@ TEST(NoAllocation, TheGyroWithTheDspChainAllocatesNothingPerFrame) {
   hrg::dsp::ChainConfig cc;
   cc.adc_full_scale_v = 2.5;
   hrg::fw::DspChainPort chain(cc);
-  hrg::fakes::FakeIdentifier ident;
+  hrg::fakes::FakeResonatorIdentifier ident;
   Gyro g(b.board, chain, ident, timer, Pacing::lockstep, config());
   counter.install();
   Eigen::internal::set_is_malloc_allowed(false);

@@ -53,30 +53,30 @@ void for_each_frame(const std::string& path, Fn fn) {
   }
 }
 
-}  // namespace
+// The DBC message a logged frame is, or nullptr (error and remote frames,
+// unknown identifiers, a wrong length or identifier format).
+const DbcMessage* known_message(const Dbc& dbc, const LoggedFrame& lf) {
+  const DbcMessage* m = lf.error_frame || lf.remote ? nullptr : dbc.message(lf.frame.id);
+  if (m == nullptr || m->extended != lf.frame.extended || lf.frame.len != m->dlc) return nullptr;
+  return m;
+}
 
-CanDecodeSummary can_decode(const CanDecodeOptions& o) {
-  const std::string dbc_path = o.dbc_path.empty() ? std::string(HRG_DEFAULT_DBC) : o.dbc_path;
-  const Dbc dbc = load_dbc(dbc_path);
-  const Layout L{&need(dbc, "HRG_WAVE_X", dbc_path), &need(dbc, "HRG_WAVE_Y", dbc_path),
-                 &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_PUMP", dbc_path),
-                 &need(dbc, "HRG_STATUS", dbc_path), &need(dbc, "HRG_INFO", dbc_path)};
-  CanDecodeSummary sum;
-  // Pass 1: metadata (K, reference frequency) and losses per message.
+// Pass 1: metadata (K, reference frequency), the first timestamp and the
+// losses per message (from each message's sequence counter). Returns the
+// first frame's time, ns.
+uint64_t scan_log(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
+                  CanDecodeSummary& sum) {
   std::map<uint32_t, int> last_seq;
   std::optional<double> k = o.angular_gain;
   std::optional<double> f_ref = o.f_ref_hz;
-  bool first = true;
   uint64_t t0_ns = 0;
   for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
-    ++sum.frames;
-    if (first) {
+    if (sum.frames++ == 0) {
       t0_ns = lf.t_ns;
       sum.t0_s = static_cast<double>(lf.t_ns) * 1e-9;
     }
-    first = false;
-    const DbcMessage* m = lf.error_frame || lf.remote ? nullptr : dbc.message(lf.frame.id);
-    if (m == nullptr || m->extended != lf.frame.extended || lf.frame.len != m->dlc) {
+    const DbcMessage* m = known_message(dbc, lf);
+    if (m == nullptr) {
       ++sum.unknown_frames;
       return;
     }
@@ -99,7 +99,12 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
                              ": no HRG_LOOPS frame gives the reference frequency; pass --f-ref-hz");
   sum.angular_gain = *k;
   sum.f_ref_hz = *f_ref;
+  return t0_ns;
+}
 
+std::vector<std::pair<std::string, std::string>> recording_metadata(const CanDecodeOptions& o,
+                                                                    const std::string& dbc_path,
+                                                                    const CanDecodeSummary& sum) {
   std::vector<std::pair<std::string, std::string>> meta;
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6f", sum.t0_s);
@@ -109,20 +114,20 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
     meta.emplace_back("can_lost_" + name,
                       std::to_string(ml.lost) + " of " + std::to_string(ml.frames + ml.lost));
   }
-  recording::RecordingWriter writer(
-      o.out_path,
-      {"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc", "pump_v", "temp_c", "f_ref_hz", "mode"},
-      sum.f_ref_hz, sum.angular_gain, meta);
+  return meta;
+}
 
-  // Pass 2: rows. A WAVE_X waits for the WAVE_Y with the same seq.
+// Pass 2: rows. A WAVE_X waits for the WAVE_Y with the same seq; the slower
+// messages give their latest values.
+void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L, uint64_t t0_ns,
+                recording::RecordingWriter& writer, CanDecodeSummary& sum) {
   double pump_v = 0, temp_c = 0, mode = 0, f_row = sum.f_ref_hz;
   bool have_x = false;
   int x_seq = 0;
   double x_t = 0, cx = 0, sx = 0, exc = 0, last_t = -1;
   for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
-    if (lf.error_frame || lf.remote) return;
-    const DbcMessage* m = dbc.message(lf.frame.id);
-    if (m == nullptr || m->extended != lf.frame.extended || lf.frame.len != m->dlc) return;
+    const DbcMessage* m = known_message(dbc, lf);
+    if (m == nullptr) return;
     const hal::CanFrame& f = lf.frame;
     // Relative time in integer nanoseconds first: epoch seconds in a double
     // would keep only ~0.2 us.
@@ -161,6 +166,23 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
       ++sum.rows;
     }
   });
+}
+
+}  // namespace
+
+CanDecodeSummary can_decode(const CanDecodeOptions& o) {
+  const std::string dbc_path = o.dbc_path.empty() ? std::string(HRG_DEFAULT_DBC) : o.dbc_path;
+  const Dbc dbc = load_dbc(dbc_path);
+  const Layout L{&need(dbc, "HRG_WAVE_X", dbc_path), &need(dbc, "HRG_WAVE_Y", dbc_path),
+                 &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_PUMP", dbc_path),
+                 &need(dbc, "HRG_STATUS", dbc_path), &need(dbc, "HRG_INFO", dbc_path)};
+  CanDecodeSummary sum;
+  const uint64_t t0_ns = scan_log(o, dbc, L, sum);
+  recording::RecordingWriter writer(
+      o.out_path,
+      {"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc", "pump_v", "temp_c", "f_ref_hz", "mode"},
+      sum.f_ref_hz, sum.angular_gain, recording_metadata(o, dbc_path, sum));
+  write_rows(o, dbc, L, t0_ns, writer, sum);
   writer.close();
   return sum;
 }

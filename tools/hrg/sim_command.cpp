@@ -53,14 +53,17 @@ std::filesystem::path plots_script() {
   return HRG_PLOTS_SCRIPT;
 }
 
-}  // namespace
-
-int sim_main(std::span<char* const> args) {
+struct SimOptions {
   std::string scenario, out_dir = "sim-out", can_log;
   double duration_s = 0.0;
   int bias_angles = 16;
   bool plots = true, quiet = false, real_time = false, static_base = false;
   bool control_drift = true;
+};
+
+// Parses the command line into `o`. Returns -1 to go on, else the exit
+// status (0 after --help, 2 on bad usage, with the message printed).
+int parse_options(std::span<char* const> args, SimOptions& o) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
     const auto value = [&](const char* what) -> const char* {
@@ -73,25 +76,17 @@ int sim_main(std::span<char* const> args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kUsage, stdout);
       return 0;
-    } else if (a == "--scenario") {
-      const char* v = value("--scenario");
+    } else if (a == "--scenario" || a == "--out" || a == "--can-log") {
+      const char* v = value(args[i]);
       if (!v) return 2;
-      scenario = v;
+      (a == "--scenario" ? o.scenario : a == "--out" ? o.out_dir : o.can_log) = v;
     } else if (a == "--duration") {
       const char* v = value("--duration");
       if (!v) return 2;
-      if (!parse_double(v, duration_s) || !(duration_s > 0)) {
+      if (!parse_double(v, o.duration_s) || !(o.duration_s > 0)) {
         std::fprintf(stderr, "hrg sim: --duration '%s' is not a positive number of seconds\n", v);
         return 2;
       }
-    } else if (a == "--out") {
-      const char* v = value("--out");
-      if (!v) return 2;
-      out_dir = v;
-    } else if (a == "--can-log") {
-      const char* v = value("--can-log");
-      if (!v) return 2;
-      can_log = v;
     } else if (a == "--bias-angles") {
       const char* v = value("--bias-angles");
       double n = 0;
@@ -100,56 +95,87 @@ int sim_main(std::span<char* const> args) {
         std::fprintf(stderr, "hrg sim: --bias-angles '%s' must be an integer in [4, 360]\n", v);
         return 2;
       }
-      bias_angles = static_cast<int>(n);
+      o.bias_angles = static_cast<int>(n);
     } else if (a == "--static-base") {
-      static_base = true;
+      o.static_base = true;
     } else if (a == "--real-time") {
-      real_time = true;
+      o.real_time = true;
     } else if (a == "--no-control-drift") {
-      control_drift = false;
+      o.control_drift = false;
     } else if (a == "--no-plots") {
-      plots = false;
+      o.plots = false;
     } else if (a == "--quiet") {
-      quiet = true;
+      o.quiet = true;
     } else {
       std::fprintf(stderr, "hrg sim: unknown option '%s'\n\n%s", args[i], kUsage);
       return 2;
     }
   }
+  return -1;
+}
 
+// The job the options ask for (throws on a bad scenario).
+simtools::JobConfig make_job(const SimOptions& o) {
+  simtools::JobConfig job;
+  if (!o.scenario.empty()) {
+    job = simtools::job_from_scenario(o.scenario, o.duration_s, o.bias_angles);
+  } else if (o.static_base) {
+    job = simtools::static_base_job(o.duration_s);
+  } else {
+    job = simtools::default_job(o.duration_s, o.bias_angles);
+  }
+  job.firmware.gyro.compensate_control_drift = o.control_drift;
+  return job;
+}
+
+// report.json, telemetry.csv, bias.csv, allan.csv into `dir` (throws).
+void write_results(const std::filesystem::path& dir, const simtools::JobConfig& job,
+                   const simtools::JobResult& r) {
+  std::ofstream(dir / "report.json") << simtools::report_json(job, r);
+  simtools::write_telemetry(dir / "telemetry.csv", job, r);
+  simtools::write_bias_csv(dir / "bias.csv", r);
+  simtools::write_allan_csv(dir / "allan.csv", r);
+}
+
+void plot(const std::filesystem::path& dir, bool quiet) {
+  const std::string cmd = "/usr/bin/python3 '" + plots_script().string() + "' '" + dir.string() +
+                          "'" + (quiet ? " >/dev/null" : "");
+  if (std::system(cmd.c_str()) != 0) {
+    std::fprintf(stderr, "hrg sim: plotting failed (%s); the results are in %s\n", cmd.c_str(),
+                 dir.string().c_str());
+  }
+}
+
+}  // namespace
+
+int sim_main(std::span<char* const> args) {
+  SimOptions o;
+  if (const int status = parse_options(args, o); status >= 0) return status;
   simtools::JobConfig job;
   try {
-    if (!scenario.empty()) {
-      job = simtools::job_from_scenario(scenario, duration_s, bias_angles);
-    } else if (static_base) {
-      job = simtools::static_base_job(duration_s);
-    } else {
-      job = simtools::default_job(duration_s, bias_angles);
-    }
+    job = make_job(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
   }
-  job.firmware.gyro.compensate_control_drift = control_drift;
-  const std::filesystem::path dir(out_dir);
+  const std::filesystem::path dir(o.out_dir);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) {
-    std::fprintf(stderr, "hrg sim: cannot create output directory '%s': %s\n", out_dir.c_str(),
+    std::fprintf(stderr, "hrg sim: cannot create output directory '%s': %s\n", o.out_dir.c_str(),
                  ec.message().c_str());
     return 2;
   }
-  if (!quiet) {
+  if (!o.quiet) {
     std::fprintf(stderr, "hrg sim: %s; %.0f simulated s -> %s\n", job.description.c_str(),
-                 job.duration_s, out_dir.c_str());
+                 job.duration_s, o.out_dir.c_str());
   }
-
   simtools::JobResult r;
   try {
     simtools::RunOptions opt;
-    opt.progress = !quiet && simtools::stderr_is_terminal();
-    opt.can_log = can_log;
-    opt.real_time = real_time;
+    opt.progress = !o.quiet && simtools::stderr_is_terminal();
+    opt.can_log = o.can_log;
+    opt.real_time = o.real_time;
     r = simtools::run_job(job, opt);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
@@ -157,24 +183,14 @@ int sim_main(std::span<char* const> args) {
   }
   const bool passed = simtools::judge(job, r);
   try {
-    std::ofstream(dir / "report.json") << simtools::report_json(job, r);
-    simtools::write_telemetry(dir / "telemetry.csv", job, r);
-    simtools::write_bias_csv(dir / "bias.csv", r);
-    simtools::write_allan_csv(dir / "allan.csv", r);
+    write_results(dir, job, r);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: writing the results: %s\n", e.what());
     return 2;
   }
-  if (!quiet) simtools::print_summary(stdout, job, r);
-  if (plots) {
-    const std::string cmd = "/usr/bin/python3 '" + plots_script().string() + "' '" + dir.string() +
-                            "'" + (quiet ? " >/dev/null" : "");
-    if (std::system(cmd.c_str()) != 0) {
-      std::fprintf(stderr, "hrg sim: plotting failed (%s); the results are in %s\n", cmd.c_str(),
-                   out_dir.c_str());
-    }
-  }
-  if (!quiet) std::fprintf(stderr, "hrg sim: results in %s\n", out_dir.c_str());
+  if (!o.quiet) simtools::print_summary(stdout, job, r);
+  if (o.plots) plot(dir, o.quiet);
+  if (!o.quiet) std::fprintf(stderr, "hrg sim: results in %s\n", o.out_dir.c_str());
   return passed ? 0 : 1;
 }
 

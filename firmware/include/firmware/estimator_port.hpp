@@ -6,10 +6,10 @@
 
 namespace hrg::fw {
 
-// The firmware's Identifier over est::Estimator (seed section 5): window
+// The firmware's ResonatorIdentifier over est::Estimator (seed section 5): window
 // samples go to the accumulator, solve() folds nothing new but re-solves and
 // accepts the model when the conditioning allows, the drift is eq. 22.
-class EstimatorPort final : public Identifier {
+class EstimatorPort final : public ResonatorIdentifier {
  public:
   explicit EstimatorPort(const est::Estimator::Config& cfg) : est_(cfg) {}
 

@@ -13,7 +13,7 @@
 #include "firmware/mode.hpp"
 #include "firmware/mode_machine.hpp"
 #include "firmware/ports.hpp"
-#include "firmware/shutdown_scheduler.hpp"
+#include "firmware/window_scheduler.hpp"
 #include "hal/board.hpp"
 
 namespace hrg::fw {
@@ -74,8 +74,8 @@ class Gyro {
 
   // `timer` measures task execution time (the board clock in real time, a
   // host clock in lockstep).
-  Gyro(hal::Board& board, SignalChain& chain, Identifier& identifier, hal::MonotonicClock& timer,
-       Pacing pacing, const GyroConfig& cfg);
+  Gyro(hal::Board& board, SignalChain& chain, ResonatorIdentifier& identifier,
+       hal::MonotonicClock& timer, Pacing pacing, const GyroConfig& cfg);
 
   // Runs one base frame (paced by the board's ADC block and clock).
   void run_frame() { exec_.run_frame(*this); }
@@ -91,9 +91,9 @@ class Gyro {
   const GyroStatus& status() const { return status_; }
   const Executive<Gyro, kTaskCount>& executive() const { return exec_; }
   const ModeMachine& mode_machine() const { return mode_; }
-  const ShutdownScheduler& scheduler() const { return scheduler_; }
+  const WindowScheduler& scheduler() const { return scheduler_; }
   const AngleOutput& output() const { return output_; }
-  const Identifier& identifier() const { return identifier_; }
+  const ResonatorIdentifier& identifier() const { return identifier_; }
   const GyroConfig& config() const { return cfg_; }
   // False when the board's converters do not match the firmware's block layout.
   bool board_ok() const { return board_ok_; }
@@ -128,13 +128,13 @@ class Gyro {
 
   hal::Board& board_;
   SignalChain& chain_;
-  Identifier& identifier_;
+  ResonatorIdentifier& identifier_;
   GyroConfig cfg_;
   hal::MonotonicClock& exec_timer_;
   Executive<Gyro, kTaskCount> exec_;
   ModeMachine mode_;
   FaultMonitor monitor_;
-  ShutdownScheduler scheduler_;
+  WindowScheduler scheduler_;
   AngleOutput output_;
   GyroStatus status_{};
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};

@@ -36,6 +36,5 @@ constexpr uint16_t fault_bit(Fault f) { return static_cast<uint16_t>(f); }
 inline constexpr uint32_t kAdcRateHz = 100'000;                     // pickoff sampling
 inline constexpr uint32_t kBlockFrames = 100;                       // ADC/DAC frames per block
 inline constexpr uint32_t kBaseRateHz = kAdcRateHz / kBlockFrames;  // 1 kHz base frame
-inline constexpr uint32_t kControlRateHz = 1'000;                   // demodulated (slow) rate
 
 }  // namespace hrg::fw

@@ -5,7 +5,7 @@
 #include <span>
 
 #include "dsp/chain.hpp"
-#include "firmware/shutdown_scheduler.hpp"
+#include "firmware/estimator_health.hpp"
 #include "hal/converters.hpp"
 
 namespace hrg::fw {
@@ -51,9 +51,9 @@ struct Identification {
 };
 
 // The estimator as the firmware sees it (seed sections 3-5).
-class Identifier {
+class ResonatorIdentifier {
  public:
-  virtual ~Identifier() = default;
+  virtual ~ResonatorIdentifier() = default;
   // Free-decay window bracket; samples in between feed the least squares.
   virtual void begin_window(double t_s) = 0;
   virtual void add_sample(const ChainRecord& s) = 0;

@@ -67,22 +67,9 @@ bool judge(const JobConfig& job, JobResult& r) {
   return r.failures.empty();
 }
 
-std::string report_json(const JobConfig& job, const JobResult& r) {
-  JsonWriter w;
-  w.begin_object();
-  w.string("scenario", job.description);
-  w.number("duration_s", r.sim_s);
-  w.number("wall_s", r.wall_s);
-  w.number("realtime_factor", r.realtime_factor);
-  w.number("realtime_factor_cpu", r.realtime_factor_cpu);
-  w.number("simulation_share", r.sim_share);
-  w.number("excitation_off_fraction", r.excitation_off_fraction);
-  w.boolean("passed", r.failures.empty());
-  w.begin_array("failures");
-  for (const auto& f : r.failures)
-    w.string({}, f);
-  w.end_array();
+namespace {
 
+void drift_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("drift");
   bias_json(w, "raw", r.fit_raw);
   bias_json(w, "compensated", r.fit_comp);
@@ -100,7 +87,9 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   }
   w.end_array();
   w.end_object();
+}
 
+void identification_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("identification");
   w.boolean("accepted", r.identification.valid);
   w.number("condition_number", r.condition);
@@ -119,7 +108,9 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
     w.end_object();
   }
   w.end_object();
+}
 
+void tracking_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("tracking");
   w.number("t_operate_s", r.t_operate_s);
   w.number("rms_deg", r.tracking_rms_deg);
@@ -129,7 +120,9 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.number("model_error_end_deg", r.model_error_end_deg);
   w.number("drift_bound_deg", r.drift_bound_deg);
   w.end_object();
+}
 
+void executive_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("executive");
   w.string("pacing", r.real_time ? "real_time" : "lockstep");
   if (r.real_time) w.string("realtime_setup", r.realtime_setup);
@@ -150,7 +143,9 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   }
   w.end_object();
   w.end_object();
+}
 
+void allan_json(JsonWriter& w, const JobResult& r) {
   w.number("allan_span_s", r.allan_span_s);
   // The flat bottom of the curve (IEEE 952 bias instability, before the 0.664 factor).
   double adev_min = 0, tau_min = 0;
@@ -170,6 +165,30 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
     w.end_object();
   }
   w.end_array();
+}
+
+}  // namespace
+
+std::string report_json(const JobConfig& job, const JobResult& r) {
+  JsonWriter w;
+  w.begin_object();
+  w.string("scenario", job.description);
+  w.number("duration_s", r.sim_s);
+  w.number("wall_s", r.wall_s);
+  w.number("realtime_factor", r.realtime_factor);
+  w.number("realtime_factor_cpu", r.realtime_factor_cpu);
+  w.number("simulation_share", r.sim_share);
+  w.number("excitation_off_fraction", r.excitation_off_fraction);
+  w.boolean("passed", r.failures.empty());
+  w.begin_array("failures");
+  for (const auto& f : r.failures)
+    w.string({}, f);
+  w.end_array();
+  drift_json(w, r);
+  identification_json(w, r);
+  tracking_json(w, r);
+  executive_json(w, r);
+  allan_json(w, r);
   w.integer("can_frames", static_cast<long long>(r.can_frames));
   w.string("final_mode", fw::to_string(r.final_mode));
   w.integer("faults_seen", r.faults_seen);

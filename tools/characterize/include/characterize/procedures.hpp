@@ -107,6 +107,11 @@ struct NoiseResult {
   std::vector<AllanPoint> curve;  // rad/s
   NoiseTerms terms;
   double record_s = 0.0;
+  // The pickoff noise read as angle: a demodulated amplitude noise sigma_a
+  // per block tilts the pattern by sigma_a / (2 a), the output by 2 / K of
+  // that; a white angle noise sigma_x gives adev = sqrt(3) sigma_x / tau. The
+  // block's decimating filter only lowers it: an upper bound (rad).
+  double readout_angle_noise_bound_rad = 0.0;
   double wall_s = 0.0, sim_s = 0.0;
 };
 NoiseResult run_noise(const ProcedureOptions& o);

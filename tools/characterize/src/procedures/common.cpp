@@ -77,5 +77,26 @@ const simtools::Row& row_at(const std::vector<simtools::Row>& rows, double t_s) 
   return *it;
 }
 
+double value_at(const std::vector<simtools::Row>& rows, double simtools::Row::*column, double t_s) {
+  if (rows.size() < 2) throw std::logic_error("procedure: too few telemetry rows");
+  auto it = std::lower_bound(rows.begin(), rows.end(), t_s,
+                             [](const simtools::Row& r, double t) { return r.t_s < t; });
+  if (it == rows.begin()) ++it;
+  if (it == rows.end()) --it;
+  const simtools::Row& a = *std::prev(it);
+  const simtools::Row& b = *it;
+  const double w = (t_s - a.t_s) / (b.t_s - a.t_s);
+  return a.*column + w * (b.*column - a.*column);
+}
+
+MeanRates mean_rates(const std::vector<simtools::Row>& rows, double simtools::Row::*column,
+                     double t0_s, double t1_s) {
+  const double dt = t1_s - t0_s;
+  const auto delta = [&](double simtools::Row::*c) {
+    return value_at(rows, c, t1_s) - value_at(rows, c, t0_s);
+  };
+  return {delta(&simtools::Row::true_angle_deg) * kDeg / dt, delta(column) * kDeg / dt};
+}
+
 }  // namespace proc
 }  // namespace hrg::characterize

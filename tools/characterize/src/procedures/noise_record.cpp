@@ -27,6 +27,8 @@ NoiseResult run_noise(const ProcedureOptions& o) {
   res.record_s = static_cast<double>(angle_rad.size()) * tau0_s;
   res.curve = allan_from_angle(angle_rad, tau0_s);
   res.terms = noise_terms(res.curve);
+  res.readout_angle_noise_bound_rad =
+      r.noise_sigma_v / (job.firmware.gyro.angular_gain * job.firmware.gyro.amplitude_set_v);
   return res;
 }
 

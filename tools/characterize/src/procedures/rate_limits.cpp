@@ -115,14 +115,12 @@ void input_rate_limit(const ProcedureOptions& o, const ProcedureBase& base, Limi
   sch.hold(1.0);
   const simtools::JobResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   for (const auto& rec : records) {
-    const simtools::Row& a = proc::row_at(r.rows, rec[0]);
-    const simtools::Row& b = proc::row_at(r.rows, rec[1]);
     bool valid = true;
     for (const simtools::Row& row : r.rows)
       if (row.t_s >= rec[0] && row.t_s <= rec[1]) valid = valid && row.out_valid;
-    const double dt = b.t_s - a.t_s;
-    const RateStep step{(b.true_angle_deg - a.true_angle_deg) * kDeg / dt,
-                        (b.out_angle_deg - a.out_angle_deg) * kDeg / dt, 0.0};
+    const proc::MeanRates m =
+        proc::mean_rates(r.rows, &simtools::Row::out_angle_deg, rec[0], rec[1]);
+    const RateStep step{m.input, m.output, 0.0};
     const bool ok =
         valid && std::fabs(step.output_rad_s / step.input_rad_s - 1.0) * 1e6 < kFollowPpm;
     res.rate_limit_steps.push_back(step);

@@ -85,10 +85,10 @@ ProcedureReport run_procedures(std::span<const std::string> names, const Procedu
     const NoiseResult n = run_noise(o);
     sheet.noise(n.curve, n.terms, 0.683);
     rep.lines.push_back(
-        line("noise: ARW %.4g deg/sqrt(h), bias instability %.4g deg/h over %.0f s "
+        line("noise: ARW %.4g deg/sqrt(h)%s, bias instability %.4g deg/h over %.0f s "
              "(%.0f s simulated, %.1f s wall)",
-             arw_deg_per_sqrt_h(n.terms.arw.value), rate_deg_per_h(n.terms.bias_instability.value),
-             n.record_s, n.sim_s, n.wall_s));
+             arw_deg_per_sqrt_h(n.terms.arw.value), n.terms.arw.on_slope ? "" : " (upper bound)",
+             rate_deg_per_h(n.terms.bias_instability.value), n.record_s, n.sim_s, n.wall_s));
     add_time(rep, n.wall_s, n.sim_s);
   }
   if (wanted(names, "rundown")) {

@@ -50,11 +50,9 @@ ScaleFactorResult run_scale_factor(const ProcedureOptions& o) {
   const simtools::JobResult run =
       proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   for (std::size_t i = 0; i < records.size(); ++i) {
-    const simtools::Row& a = proc::row_at(run.rows, records[i].t0_s);
-    const simtools::Row& b = proc::row_at(run.rows, records[i].t1_s);
-    const double dt = b.t_s - a.t_s;
-    res.steps.push_back({(b.true_angle_deg - a.true_angle_deg) * kDeg / dt,
-                         (b.out_angle_deg - a.out_angle_deg) * kDeg / dt, 0.0});
+    const proc::MeanRates m =
+        proc::mean_rates(run.rows, &simtools::Row::out_angle_deg, records[i].t0_s, records[i].t1_s);
+    res.steps.push_back({m.input, m.output, 0.0});
     if (i >= 2) continue;  // the readout's 4 theta pattern from the slowest steps
     for (const simtools::Row& row : run.rows) {
       if (row.t_s < records[i].t0_s || row.t_s > records[i].t1_s || !row.out_valid) continue;

@@ -10,7 +10,7 @@
 namespace hrg::fw::can {
 
 // The HRG CAN protocol (classic CAN, 1 Mbit/s, 11-bit identifiers). The same
-// layout is written in firmware/can/hrg.dbc; tests/hal/test_can_dbc.cpp parses
+// layout is written in firmware/can/hrg.dbc; tests/tools/test_can_dbc.cpp parses
 // the DBC and checks that every message and signal below agrees with it.
 //
 // Identifiers: host commands 0x080-0x08F (highest priority), the command reply

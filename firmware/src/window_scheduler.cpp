@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "firmware/shutdown_scheduler.hpp"
+#include "firmware/window_scheduler.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -10,7 +10,7 @@ namespace {
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 }  // namespace
 
-ShutdownScheduler::ShutdownScheduler(const WindowConfig& cfg) : cfg_(cfg) {
+WindowScheduler::WindowScheduler(const WindowConfig& cfg) : cfg_(cfg) {
   if (cfg_.bins == 0) cfg_.bins = 1;
   if (cfg_.bins > kMaxBins) cfg_.bins = kMaxBins;
   if (cfg_.length_frames == 0) cfg_.length_frames = 1;
@@ -18,14 +18,14 @@ ShutdownScheduler::ShutdownScheduler(const WindowConfig& cfg) : cfg_(cfg) {
   since_start_ = cfg_.period_frames;
 }
 
-uint32_t ShutdownScheduler::bin_of(double theta_rad) const {
+uint32_t WindowScheduler::bin_of(double theta_rad) const {
   double phase = std::fmod(4.0 * theta_rad, kTwoPi);
   if (phase < 0) phase += kTwoPi;
   auto bin = static_cast<uint32_t>(phase / kTwoPi * cfg_.bins);
   return bin >= cfg_.bins ? cfg_.bins - 1 : bin;
 }
 
-double ShutdownScheduler::bin_centre_near(uint32_t bin, double from_rad) const {
+double WindowScheduler::bin_centre_near(uint32_t bin, double from_rad) const {
   // 4 theta at the bin centre; theta repeats every pi/2.
   const double centre = (static_cast<double>(bin) + 0.5) * kTwoPi / cfg_.bins / 4.0;
   const double quarter = std::numbers::pi / 2.0;
@@ -33,12 +33,12 @@ double ShutdownScheduler::bin_centre_near(uint32_t bin, double from_rad) const {
   return centre + k * quarter;
 }
 
-bool ShutdownScheduler::under_covered(uint32_t bin) const {
+bool WindowScheduler::under_covered(uint32_t bin) const {
   // Fill evenly: only bins at the current minimum count qualify.
   return counts_[bin] <= counts_[least_covered_bin()];
 }
 
-uint32_t ShutdownScheduler::least_covered_bin() const {
+uint32_t WindowScheduler::least_covered_bin() const {
   uint32_t best = 0;
   for (uint32_t b = 1; b < cfg_.bins; ++b) {
     if (counts_[b] < counts_[best]) best = b;
@@ -46,12 +46,12 @@ uint32_t ShutdownScheduler::least_covered_bin() const {
   return best;
 }
 
-double ShutdownScheduler::excitation_off_fraction() const {
+double WindowScheduler::excitation_off_fraction() const {
   return frames_ == 0 ? 0.0 : static_cast<double>(off_frames_) / static_cast<double>(frames_);
 }
 
-WindowDecision ShutdownScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
-                                       const EstimatorHealth& health) {
+WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
+                                     const EstimatorHealth& health) {
   WindowDecision d;
   ++frames_;
   if (since_start_ < UINT32_MAX) ++since_start_;

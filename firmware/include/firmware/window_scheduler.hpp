@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 
+#include "firmware/estimator_health.hpp"
 #include "firmware/mode.hpp"
 
 namespace hrg::fw {
@@ -25,13 +26,6 @@ struct WindowConfig {
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
 };
 
-// What the estimator reports about its own state.
-struct EstimatorHealth {
-  bool solved = false;     // a solution exists
-  double condition = 0.0;  // condition number of H^T H (max/min eigenvalue)
-  double coverage = 0.0;   // share of 4 theta bins with data, 0..1
-};
-
 struct WindowDecision {
   bool open = false;              // start a free-decay window now
   bool close = false;             // end the running window now
@@ -39,11 +33,11 @@ struct WindowDecision {
   double pattern_target_rad = 0;  // theta_A target (physical angle)
 };
 
-class ShutdownScheduler {
+class WindowScheduler {
  public:
   static constexpr uint32_t kMaxBins = 64;
 
-  explicit ShutdownScheduler(const WindowConfig& cfg = {});
+  explicit WindowScheduler(const WindowConfig& cfg = {});
 
   // Once per base frame. `theta_rad`: theta_A (unwrapped or not);
   // `theta_rate_rad_s`: its smoothed rate, used to tell a static base.

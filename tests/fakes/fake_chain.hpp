@@ -65,7 +65,7 @@ class FakeChain final : public fw::SignalChain {
 };
 
 // Records what the firmware asks of the identifier. Back door: health and drift.
-class FakeIdentifier final : public fw::Identifier {
+class FakeResonatorIdentifier final : public fw::ResonatorIdentifier {
  public:
   void begin_window(double t_s) override {
     ++begun;

@@ -7,6 +7,7 @@
 
 #include "fakes/fake_clock.hpp"
 #include "firmware/mode.hpp"
+#include "fakes/fake_can.hpp"
 #include "hal/board.hpp"
 
 namespace hrg::fakes {
@@ -107,55 +108,6 @@ class FakeDigitalIn final : public hal::DigitalIn {
 
  private:
   bool level_ = false;
-};
-
-// A CAN bus that accepts and counts every frame and keeps the last ones sent.
-// Back door: inject() queues a received frame (up to 16).
-class FakeCan final : public hal::CanBus {
- public:
-  hal::Status send(const hal::CanFrame& f) override {
-    last_ = f;
-    sent_[counters_.tx_frames % sent_.size()] = f;
-    ++counters_.tx_frames;
-    return hal::Status::ok;
-  }
-  hal::Status receive(hal::CanFrame& f) override {
-    if (rx_head_ == rx_tail_) return hal::Status::would_block;
-    f = rx_[rx_head_++ % rx_.size()];
-    ++counters_.rx_frames;
-    return hal::Status::ok;
-  }
-  bool inject(const hal::CanFrame& f) {
-    if (rx_tail_ - rx_head_ >= rx_.size()) return false;
-    rx_[rx_tail_++ % rx_.size()] = f;
-    return true;
-  }
-  // The last frame sent with identifier `id`, if among the last 64 sent.
-  bool last_with_id(uint32_t id, hal::CanFrame& out) const {
-    const uint32_t n = counters_.tx_frames < sent_.size() ? counters_.tx_frames
-                                                          : static_cast<uint32_t>(sent_.size());
-    for (uint32_t k = 1; k <= n; ++k) {
-      const auto& f = sent_[(counters_.tx_frames - k) % sent_.size()];
-      if (f.id == id) {
-        out = f;
-        return true;
-      }
-    }
-    return false;
-  }
-  hal::Status set_filters(std::span<const hal::CanFilter>) override { return hal::Status::ok; }
-  hal::CanState state() const override { return hal::CanState::error_active; }
-  hal::Status restart() override { return hal::Status::ok; }
-  hal::CanCounters counters() const override { return counters_; }
-  const hal::CanFrame& last() const { return last_; }
-
- private:
-  hal::CanCounters counters_{};
-  hal::CanFrame last_{};
-  std::array<hal::CanFrame, 64> sent_{};
-  std::array<hal::CanFrame, 16> rx_{};
-  uint32_t rx_head_ = 0;
-  uint32_t rx_tail_ = 0;
 };
 
 // A whole board on the fakes, in lockstep.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "firmware/shutdown_scheduler.hpp"
+#include "firmware/window_scheduler.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -9,9 +9,9 @@
 
 using hrg::fw::EstimatorHealth;
 using hrg::fw::Mode;
-using hrg::fw::ShutdownScheduler;
 using hrg::fw::WindowConfig;
 using hrg::fw::WindowDecision;
+using hrg::fw::WindowScheduler;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
@@ -28,7 +28,7 @@ WindowConfig small_config() {
 
 // A minimal mode machine for the scheduler: operate <-> free_decay.
 struct Loop {
-  ShutdownScheduler s;
+  WindowScheduler s;
   Mode mode = Mode::operate;
   uint32_t opened = 0;
   explicit Loop(const WindowConfig& c) : s(c) {}
@@ -44,10 +44,10 @@ struct Loop {
 };
 }  // namespace
 
-TEST_GROUP(ShutdownScheduler){};
+TEST_GROUP(WindowScheduler){};
 
-TEST(ShutdownScheduler, BinsFollowFourThetaAndRepeatEveryQuarterTurn) {
-  ShutdownScheduler s(small_config());  // 8 bins of 45 deg in 4 theta
+TEST(WindowScheduler, BinsFollowFourThetaAndRepeatEveryQuarterTurn) {
+  WindowScheduler s(small_config());  // 8 bins of 45 deg in 4 theta
   LONGS_EQUAL(0, s.bin_of(0.0));
   LONGS_EQUAL(1, s.bin_of(kPi / 16 + 1e-6));  // 4 theta just above 45 deg
   LONGS_EQUAL(7, s.bin_of(-1e-6));            // just below 0 wraps to the last bin
@@ -56,7 +56,7 @@ TEST(ShutdownScheduler, BinsFollowFourThetaAndRepeatEveryQuarterTurn) {
   DOUBLES_EQUAL(kPi / 32 + kPi / 2, s.bin_centre_near(0, kPi / 2), 1e-12);
 }
 
-TEST(ShutdownScheduler, WindowsHaveTheConfiguredLengthAndPeriod) {
+TEST(WindowScheduler, WindowsHaveTheConfiguredLengthAndPeriod) {
   Loop l(small_config());
   // Turning base, theta sweeping fast: every bin is under-covered in turn.
   uint32_t first_open = 0, second_open = 0, closes = 0, off = 0;
@@ -75,7 +75,7 @@ TEST(ShutdownScheduler, WindowsHaveTheConfiguredLengthAndPeriod) {
   DOUBLES_EQUAL(40.0 / 200.0, l.s.excitation_off_fraction(), 1e-12);
 }
 
-TEST(ShutdownScheduler, PrefersUnderCoveredBinsAndWaitsInACoveredOne) {
+TEST(WindowScheduler, PrefersUnderCoveredBinsAndWaitsInACoveredOne) {
   auto c = small_config();
   c.max_wait_frames = 10'000;
   Loop l(c);
@@ -93,7 +93,7 @@ TEST(ShutdownScheduler, PrefersUnderCoveredBinsAndWaitsInACoveredOne) {
   CHECK(d.open);
 }
 
-TEST(ShutdownScheduler, OpensAnywayAfterTheLongestWaitOnAMovingBase) {
+TEST(WindowScheduler, OpensAnywayAfterTheLongestWaitOnAMovingBase) {
   Loop l(small_config());  // max wait 400
   for (int f = 0; f < 11; ++f)
     l.frame(0.01, 2.0);
@@ -106,7 +106,7 @@ TEST(ShutdownScheduler, OpensAnywayAfterTheLongestWaitOnAMovingBase) {
   LONGS_EQUAL(400, f - 1);  // 400 frames after the first window opened at frame 0
 }
 
-TEST(ShutdownScheduler, OnAStaticBaseItCommandsThePatternToTheLeastCoveredBin) {
+TEST(WindowScheduler, OnAStaticBaseItCommandsThePatternToTheLeastCoveredBin) {
   Loop l(small_config());
   for (int f = 0; f < 11; ++f)
     l.frame(0.01, 0.0);  // window in bin 0
@@ -123,7 +123,7 @@ TEST(ShutdownScheduler, OnAStaticBaseItCommandsThePatternToTheLeastCoveredBin) {
   LONGS_EQUAL(2, l.opened);
 }
 
-TEST(ShutdownScheduler, StopsWhenTheEstimatorReportsGoodConditionAndCoverage) {
+TEST(WindowScheduler, StopsWhenTheEstimatorReportsGoodConditionAndCoverage) {
   Loop l(small_config());
   EstimatorHealth good{true, 50.0, 1.0};
   EstimatorHealth poor{true, 1e6, 1.0};
@@ -138,8 +138,8 @@ TEST(ShutdownScheduler, StopsWhenTheEstimatorReportsGoodConditionAndCoverage) {
   LONGS_EQUAL(before, l.opened);  // a window running at the time may finish, none opens after
 }
 
-TEST(ShutdownScheduler, AWindowAbortedByAFaultDoesNotCount) {
-  ShutdownScheduler s(small_config());
+TEST(WindowScheduler, AWindowAbortedByAFaultDoesNotCount) {
+  WindowScheduler s(small_config());
   auto d = s.step(Mode::operate, 0.01, 2.0, {});
   CHECK(d.open);
   s.step(Mode::free_decay, 0.01, 2.0, {});
@@ -149,7 +149,7 @@ TEST(ShutdownScheduler, AWindowAbortedByAFaultDoesNotCount) {
   LONGS_EQUAL(0, s.windows());
 }
 
-TEST(ShutdownScheduler, FillsAllBinsEvenlyOnASweep) {
+TEST(WindowScheduler, FillsAllBinsEvenlyOnASweep) {
   auto c = small_config();
   c.windows_per_bin = 3;
   c.condition_good = 0;  // the estimator never says good: the cap ends the campaign
@@ -166,7 +166,7 @@ TEST(ShutdownScheduler, FillsAllBinsEvenlyOnASweep) {
   CHECK(hi - lo <= 1);
 }
 
-TEST(ShutdownScheduler, TheEstimatorsWordCountsOnlyOnceEveryBinHasItsMinimum) {
+TEST(WindowScheduler, TheEstimatorsWordCountsOnlyOnceEveryBinHasItsMinimum) {
   auto c = small_config();
   c.min_windows_per_bin = 1;
   c.windows_per_bin = 100;
@@ -183,7 +183,7 @@ TEST(ShutdownScheduler, TheEstimatorsWordCountsOnlyOnceEveryBinHasItsMinimum) {
   LONGS_EQUAL(8, l.s.windows());
 }
 
-TEST(ShutdownScheduler, OnAStaticBaseThePatternWalksToTheNearestEmptyBin) {
+TEST(WindowScheduler, OnAStaticBaseThePatternWalksToTheNearestEmptyBin) {
   Loop l(small_config());  // 8 bins of 11.25 deg of theta
   // GIVEN windows taken in bins 0 and 1 (theta 0.01 and 0.25)
   for (int f = 0; f < 11; ++f)

@@ -3,30 +3,27 @@
 // poll, refusals are dropped, telemetry refusals are counted, and bus-off is
 // left by a restart after the configured number of frames. The fake has tests
 // of its own first.
-#include <deque>
-#include <vector>
-
-#include "fake_can_bus.hpp"
+#include "fakes/fake_can.hpp"
 #include "firmware/can/link.hpp"
 
 #include "support/cpputest.hpp"
 
 using namespace hrg::fw::can;
+using hrg::fakes::FakeCan;
 using hrg::fw::Mode;
 using hrg::hal::CanFrame;
 using hrg::hal::CanState;
 using hrg::hal::Status;
-using hrg::test::FakeCanBus;
 
-TEST_GROUP(FakeCanBus) { FakeCanBus bus; };
+TEST_GROUP(FakeCan) { FakeCan bus; };
 
-TEST(FakeCanBus, ReceivesWhatTheBackDoorQueuedInOrder) {
+TEST(FakeCan, ReceivesWhatTheBackDoorQueuedInOrder) {
   CanFrame a;
   a.id = 1;
   CanFrame b;
   b.id = 2;
-  bus.push_rx(a);
-  bus.push_rx(b);
+  bus.inject(a);
+  bus.inject(b);
   CanFrame f;
   CHECK(Status::ok == bus.receive(f));
   LONGS_EQUAL(1, f.id);
@@ -35,7 +32,7 @@ TEST(FakeCanBus, ReceivesWhatTheBackDoorQueuedInOrder) {
   CHECK(Status::would_block == bus.receive(f));
 }
 
-TEST(FakeCanBus, RefusesSendsWhenToldAndWhileBusOff) {
+TEST(FakeCan, RefusesSendsWhenToldAndWhileBusOff) {
   CanFrame f;
   bus.set_send_result(Status::would_block);
   CHECK(Status::would_block == bus.send(f));
@@ -45,11 +42,11 @@ TEST(FakeCanBus, RefusesSendsWhenToldAndWhileBusOff) {
   CHECK(Status::bus_off == bus.send(f));
   CHECK(Status::ok == bus.restart());
   CHECK(Status::ok == bus.send(f));
-  LONGS_EQUAL(1, bus.sent().size());
+  LONGS_EQUAL(1, bus.sent_count());
 }
 
 TEST_GROUP(CanLink) {
-  FakeCanBus bus;
+  FakeCan bus;
   CanLink link{bus, 100};
   ControllerView operating() {
     ControllerView v;
@@ -59,8 +56,8 @@ TEST_GROUP(CanLink) {
   }
   Reply last_reply() {
     Reply r;
-    CHECK(!bus.sent().empty());
-    CHECK(decode_reply(bus.sent().back(), r));
+    CHECK(bus.sent_count() > 0);
+    CHECK(decode_reply(bus.last(), r));
     return r;
   }
 };
@@ -73,7 +70,7 @@ TEST(CanLink, InitAcceptsOnlyTheCommandRange) {
 }
 
 TEST(CanLink, AnAcceptedCommandIsReturnedAndAnswered) {
-  bus.push_rx(encode_agc(1.1, 1));
+  bus.inject(encode_agc(1.1, 1));
   Command c;
   CHECK(link.poll(operating(), c));
   CHECK(c.id == Cmd::agc);
@@ -85,24 +82,24 @@ TEST(CanLink, AnAcceptedCommandIsReturnedAndAnswered) {
 TEST(CanLink, RefusedCommandsAreAnsweredAndDroppedAndTheNextIsReturned) {
   CanFrame bad = encode_agc(1.1, 1);
   bad.data[0] ^= 1;  // checksum now wrong
-  bus.push_rx(bad);
+  bus.inject(bad);
   CanFrame telemetry;
   telemetry.id = 0x100;  // not a command: no reply
-  bus.push_rx(telemetry);
-  bus.push_rx(encode_status_request(2));
+  bus.inject(telemetry);
+  bus.inject(encode_status_request(2));
   Command c;
   CHECK(link.poll(operating(), c));
   CHECK(c.id == Cmd::status_request);
-  LONGS_EQUAL(2, bus.sent().size());  // two replies
+  LONGS_EQUAL(2, bus.sent_count());  // two replies
   Reply r;
-  CHECK(decode_reply(bus.sent()[0], r));
+  CHECK(decode_reply(bus.sent(0), r));
   LONGS_EQUAL(static_cast<int>(CommandResult::bad_checksum), static_cast<int>(r.result));
   LONGS_EQUAL(1, link.stats().commands_refused);
 }
 
 TEST(CanLink, OneCommandPerPollSoTheNextSeesTheAppliedState) {
-  bus.push_rx(encode_ident(true, 1));
-  bus.push_rx(encode_ident(true, 2));
+  bus.inject(encode_ident(true, 1));
+  bus.inject(encode_ident(true, 2));
   Command c;
   CHECK(link.poll(operating(), c));
   // The firmware applied the first: identification now runs, so a second
@@ -122,7 +119,7 @@ TEST(CanLink, TelemetryRefusedByAFullQueueIsCountedNotQueued) {
   bus.set_send_result(Status::ok);
   link.send(frames);
   LONGS_EQUAL(3, link.stats().tx_refused);
-  LONGS_EQUAL(3, bus.sent().size());
+  LONGS_EQUAL(3, bus.sent_count());
 }
 
 TEST(CanLink, BusOffIsLeftByOneRestartAfterTheConfiguredFrames) {
