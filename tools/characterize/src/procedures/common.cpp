@@ -56,10 +56,10 @@ simtools::JobResult run(const simtools::JobConfig& job, const ProcedureOptions& 
   return r;
 }
 
-double rate_of(const std::vector<simtools::Row>& rows, double simtools::Row::*column, double t0_s,
-               double t1_s) {
+double rate_of(const std::vector<simtools::TelemetryRow>& rows,
+               double simtools::TelemetryRow::*column, double t0_s, double t1_s) {
   std::vector<double> t, y;
-  for (const simtools::Row& row : rows) {
+  for (const simtools::TelemetryRow& row : rows) {
     if (row.t_s < t0_s || row.t_s > t1_s || !row.out_valid) continue;
     t.push_back(row.t_s);
     y.push_back(row.*column);
@@ -67,35 +67,37 @@ double rate_of(const std::vector<simtools::Row>& rows, double simtools::Row::*co
   return t.size() < 3 ? 0.0 : simtools::slope(t, y);
 }
 
-const simtools::Row& row_at(const std::vector<simtools::Row>& rows, double t_s) {
+const simtools::TelemetryRow& row_at(const std::vector<simtools::TelemetryRow>& rows, double t_s) {
   if (rows.empty()) throw std::logic_error("procedure: no telemetry rows");
-  const auto it = std::lower_bound(rows.begin(), rows.end(), t_s,
-                                   [](const simtools::Row& r, double t) { return r.t_s < t; });
+  const auto it =
+      std::lower_bound(rows.begin(), rows.end(), t_s,
+                       [](const simtools::TelemetryRow& r, double t) { return r.t_s < t; });
   if (it == rows.end()) return rows.back();
   if (it != rows.begin() && std::fabs(std::prev(it)->t_s - t_s) < std::fabs(it->t_s - t_s))
     return *std::prev(it);
   return *it;
 }
 
-double value_at(const std::vector<simtools::Row>& rows, double simtools::Row::*column, double t_s) {
+double value_at(const std::vector<simtools::TelemetryRow>& rows,
+                double simtools::TelemetryRow::*column, double t_s) {
   if (rows.size() < 2) throw std::logic_error("procedure: too few telemetry rows");
   auto it = std::lower_bound(rows.begin(), rows.end(), t_s,
-                             [](const simtools::Row& r, double t) { return r.t_s < t; });
+                             [](const simtools::TelemetryRow& r, double t) { return r.t_s < t; });
   if (it == rows.begin()) ++it;
   if (it == rows.end()) --it;
-  const simtools::Row& a = *std::prev(it);
-  const simtools::Row& b = *it;
+  const simtools::TelemetryRow& a = *std::prev(it);
+  const simtools::TelemetryRow& b = *it;
   const double w = (t_s - a.t_s) / (b.t_s - a.t_s);
   return a.*column + w * (b.*column - a.*column);
 }
 
-MeanRates mean_rates(const std::vector<simtools::Row>& rows, double simtools::Row::*column,
-                     double t0_s, double t1_s) {
+MeanRates mean_rates(const std::vector<simtools::TelemetryRow>& rows,
+                     double simtools::TelemetryRow::*column, double t0_s, double t1_s) {
   const double dt = t1_s - t0_s;
-  const auto delta = [&](double simtools::Row::*c) {
+  const auto delta = [&](double simtools::TelemetryRow::*c) {
     return value_at(rows, c, t1_s) - value_at(rows, c, t0_s);
   };
-  return {delta(&simtools::Row::true_angle_deg) * kDeg / dt, delta(column) * kDeg / dt};
+  return {delta(&simtools::TelemetryRow::true_angle_deg) * kDeg / dt, delta(column) * kDeg / dt};
 }
 
 }  // namespace proc

@@ -41,23 +41,24 @@ simtools::JobResult run(const simtools::JobConfig& job, const ProcedureOptions& 
 
 // Least-squares slope (per s) of `column` over rows in [t0_s, t1_s] with a
 // valid output; 0 when fewer than 3 rows.
-double rate_of(const std::vector<simtools::Row>& rows, double simtools::Row::*column, double t0_s,
-               double t1_s);
+double rate_of(const std::vector<simtools::TelemetryRow>& rows,
+               double simtools::TelemetryRow::*column, double t0_s, double t1_s);
 
 // `column` at time t_s, linear between the two rows around it: a step's
 // ends fall between rows, and over whole 4 theta cycles the readout's 4 theta
 // error cancels only when both ends are read at the cycle's own instants.
-double value_at(const std::vector<simtools::Row>& rows, double simtools::Row::*column, double t_s);
+double value_at(const std::vector<simtools::TelemetryRow>& rows,
+                double simtools::TelemetryRow::*column, double t_s);
 
 // The mean rate of `column` (per s) against that of the true input angle
 // between t0_s and t1_s: {input, output}.
 struct MeanRates {
   double input = 0.0, output = 0.0;
 };
-MeanRates mean_rates(const std::vector<simtools::Row>& rows, double simtools::Row::*column,
-                     double t0_s, double t1_s);
+MeanRates mean_rates(const std::vector<simtools::TelemetryRow>& rows,
+                     double simtools::TelemetryRow::*column, double t0_s, double t1_s);
 
 // The row nearest time t_s.
-const simtools::Row& row_at(const std::vector<simtools::Row>& rows, double t_s);
+const simtools::TelemetryRow& row_at(const std::vector<simtools::TelemetryRow>& rows, double t_s);
 
 }  // namespace hrg::characterize::proc

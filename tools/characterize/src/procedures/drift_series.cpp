@@ -15,8 +15,8 @@ using proc::kDeg;
 constexpr double kSettleS = 5.0;  // after the sweep, before the bias is read
 
 // Bias of the output (deg/h): the slope of output minus true angle.
-double bias_dph(const std::vector<simtools::Row>& rows, double simtools::Row::*error, double t0_s,
-                double t1_s) {
+double bias_dph(const std::vector<simtools::TelemetryRow>& rows,
+                double simtools::TelemetryRow::*error, double t0_s, double t1_s) {
   return proc::rate_of(rows, error, t0_s, t1_s) * 3600.0;
 }
 
@@ -29,7 +29,8 @@ void turn_ons(const ProcedureOptions& o, const ProcedureBase& base, DriftResult&
     const double t0 = sch.t() + kSettleS;
     sch.hold(kSettleS + hold_s);
     const simtools::JobResult r = proc::run(proc::scheduled_job(b, sch), o, res.wall_s, res.sim_s);
-    res.turn_on_bias_dph.push_back(bias_dph(r.rows, &simtools::Row::out_error_deg, t0, sch.t()));
+    res.turn_on_bias_dph.push_back(
+        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, t0, sch.t()));
   }
   res.repeatability = bias_repeatability(res.turn_on_bias_dph);
 }
@@ -52,7 +53,7 @@ void temperature_ramp(const ProcedureOptions& o, const ProcedureBase& base, Drif
   for (int s = 0; s < kSegments; ++s) {
     const double a = t0 + hold_s * s / kSegments, b = t0 + hold_s * (s + 1) / kSegments;
     double temp_sum = 0.0, n = 0.0;
-    for (const simtools::Row& row : r.rows) {
+    for (const simtools::TelemetryRow& row : r.rows) {
       if (row.t_s < a || row.t_s > b) continue;
       temp_sum += row.temp_c;
       model_sum += row.drift_true_dph;
@@ -60,8 +61,10 @@ void temperature_ramp(const ProcedureOptions& o, const ProcedureBase& base, Drif
       n += 1.0;
     }
     res.temperature_c.push_back(n > 0 ? temp_sum / n : 0.0);
-    res.temperature_bias_dph.push_back(bias_dph(r.rows, &simtools::Row::out_error_deg, a, b));
-    res.temperature_raw_bias_dph.push_back(bias_dph(r.rows, &simtools::Row::raw_error_deg, a, b));
+    res.temperature_bias_dph.push_back(
+        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, a, b));
+    res.temperature_raw_bias_dph.push_back(
+        bias_dph(r.rows, &simtools::TelemetryRow::raw_error_deg, a, b));
   }
   res.temperature_model_dph = model_n > 0 ? model_sum / model_n : 0.0;
   res.temperature = bias_temperature_slope(res.temperature_c, res.temperature_bias_dph);
@@ -82,8 +85,8 @@ DriftResult run_angle_dependent_bias(const ProcedureOptions& o) {
   res.adb_model = r.fit_model;
   res.parks = r.parks;
   // The pattern turns against the case at -K / 2: measured over the sweep.
-  const simtools::Row& a = proc::row_at(r.rows, simtools::kRingUpS);
-  const simtools::Row& b = proc::row_at(r.rows, job.sweep_end_s);
+  const simtools::TelemetryRow& a = proc::row_at(r.rows, simtools::kRingUpS);
+  const simtools::TelemetryRow& b = proc::row_at(r.rows, job.sweep_end_s);
   res.theta_at_sweep_end_deg = b.theta_deg;
   res.pattern_per_case = (b.theta_deg - a.theta_deg) / (b.true_angle_deg - a.true_angle_deg);
   return res;

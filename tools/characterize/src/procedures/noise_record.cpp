@@ -18,7 +18,7 @@ NoiseResult run_noise(const ProcedureOptions& o) {
   NoiseResult res;
   const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
   std::vector<double> angle_rad;
-  for (const simtools::Row& row : r.rows) {
+  for (const simtools::TelemetryRow& row : r.rows) {
     if (row.t_s < t0) continue;
     if (!row.out_valid) break;  // one contiguous stretch
     angle_rad.push_back(row.out_error_deg * proc::kDeg);

@@ -66,14 +66,16 @@ void rate_threshold(const ProcedureOptions& o, const ProcedureBase& base, const 
   double theta_sum = 0, d_true = 0, d_model = 0, n = 0;
   for (const Hold& h : holds) {
     ThresholdStep st;
-    st.input_dph = proc::rate_of(r.rows, &simtools::Row::true_angle_deg, h.t0, h.t1) * 3600.0;
-    st.raw_dph = proc::rate_of(r.rows, &simtools::Row::raw_angle_deg, h.t0, h.t1) * 3600.0;
-    st.comp_dph = proc::rate_of(r.rows, &simtools::Row::out_angle_deg, h.t0, h.t1) * 3600.0;
+    st.input_dph =
+        proc::rate_of(r.rows, &simtools::TelemetryRow::true_angle_deg, h.t0, h.t1) * 3600.0;
+    st.raw_dph = proc::rate_of(r.rows, &simtools::TelemetryRow::raw_angle_deg, h.t0, h.t1) * 3600.0;
+    st.comp_dph =
+        proc::rate_of(r.rows, &simtools::TelemetryRow::out_angle_deg, h.t0, h.t1) * 3600.0;
     res.threshold_steps.push_back(st);
     in.push_back(st.input_dph);
     raw.push_back(st.raw_dph);
     comp.push_back(st.comp_dph);
-    for (const simtools::Row& row : r.rows) {
+    for (const simtools::TelemetryRow& row : r.rows) {
       if (row.t_s < h.t0 || row.t_s > h.t1) continue;
       theta_sum += row.theta_deg;
       d_true += row.drift_true_dph;
@@ -116,10 +118,10 @@ void input_rate_limit(const ProcedureOptions& o, const ProcedureBase& base, Limi
   const simtools::JobResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   for (const auto& rec : records) {
     bool valid = true;
-    for (const simtools::Row& row : r.rows)
+    for (const simtools::TelemetryRow& row : r.rows)
       if (row.t_s >= rec[0] && row.t_s <= rec[1]) valid = valid && row.out_valid;
     const proc::MeanRates m =
-        proc::mean_rates(r.rows, &simtools::Row::out_angle_deg, rec[0], rec[1]);
+        proc::mean_rates(r.rows, &simtools::TelemetryRow::out_angle_deg, rec[0], rec[1]);
     const RateStep step{m.input, m.output, 0.0};
     const bool ok =
         valid && std::fabs(step.output_rad_s / step.input_rad_s - 1.0) * 1e6 < kFollowPpm;

@@ -28,13 +28,13 @@ RundownResult run_rundown(const ProcedureOptions& o) {
   const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
 
   const double t0 = t_off + 1.0;  // the rows' averaging span free of the drive
-  const simtools::Row& first = proc::row_at(r.rows, t0);
+  const simtools::TelemetryRow& first = proc::row_at(r.rows, t0);
   const sim::ResonatorParams& p = base.job.sim.resonator;
   res.amplitude0_v = std::hypot(first.a_a_v, first.a_b_v);
   res.noise_floor_v = r.noise_sigma_v;
   std::vector<double> t, log_a;
   double offset_deg = first.theta_deg - first.true_theta_deg;
-  for (const simtools::Row& row : r.rows) {
+  for (const simtools::TelemetryRow& row : r.rows) {
     if (row.t_s < t0) continue;
     const double a = std::hypot(row.a_a_v, row.a_b_v);
     const double tt = row.t_s - t0;
