@@ -52,11 +52,13 @@ DriftResult drift_part(const ProcedureOptions& o, bool drift, DataSheet& sheet,
     sheet.drift(d.turn_on_bias_dph, d.repeatability, d.temperature_c, d.temperature_bias_dph,
                 d.temperature);
   }
-  rep.lines.push_back(
-      line("drift: ADB raw %.3f, comp %.3f deg/h; repeatability %.4f deg/h over "
-           "%zu; temperature %.4g deg/h/degC (%.0f s simulated, %.1f s wall)",
-           d.adb_raw.amplitude(), d.adb_comp.amplitude(), d.repeatability.std, d.repeatability.runs,
-           d.temperature.slope_per_degc, d.sim_s, d.wall_s));
+  std::string figures =
+      line("drift: ADB raw %.3f, comp %.3f deg/h", d.adb_raw.amplitude(), d.adb_comp.amplitude());
+  if (drift) {
+    figures += line("; repeatability %.4f deg/h over %zu; temperature %.4g deg/h/degC",
+                    d.repeatability.std, d.repeatability.runs, d.temperature.slope_per_degc);
+  }
+  rep.lines.push_back(figures + line(" (%.0f s simulated, %.1f s wall)", d.sim_s, d.wall_s));
   add_time(rep, d.wall_s, d.sim_s);
   return d;
 }
