@@ -92,7 +92,9 @@ TEST(Procedures, RateThresholdRawAndCompensated) {
   DOUBLES_EQUAL(58.48, l.closed_form_dph, 0.01);
   DOUBLES_EQUAL(l.closed_form_dph, l.measured_raw_dph, 0.10 * l.closed_form_dph);
   DOUBLES_EQUAL(l.predicted_raw_dph, l.measured_raw_dph, 0.01 * l.closed_form_dph);
-  DOUBLES_EQUAL(l.predicted_comp_dph, l.measured_comp_dph, 0.1);
+  // The same resolution as the raw crossing: the four 10 s holds read the rate
+  // to ~0.25 deg/h each at the gyro's ARW (0.025 deg/sqrt(h)).
+  DOUBLES_EQUAL(l.predicted_comp_dph, l.measured_comp_dph, 0.01 * l.closed_form_dph);
   CHECK(std::fabs(l.measured_comp_dph) < 0.02 * l.measured_raw_dph);
   CHECK(l.largest_followed_dps >= 300.0);
 }
