@@ -114,6 +114,10 @@ TEST(AuditCalibration, EveryFindingGoesToItsFieldInSiUnitsAndFeedthroughToThePum
                         line.find("not an accepted finding") != std::string::npos);
   }
   CHECK_TRUE(listed);
+  bool gap = false;
+  for (const auto& line : c.comments)
+    gap = gap || line.find("not examined: ring-electrode") == 0;
+  CHECK_TRUE(gap);
 }
 
 TEST(AuditCalibration, AFindingOutsideTheFirmwaresRangeWritesNothing) {

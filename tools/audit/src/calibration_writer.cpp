@@ -110,6 +110,9 @@ CalibrationFromAudit calibration_from_audit(const AuditResult& r, const std::str
     c.push_back("ambiguous: " + r.ambiguity_experiment);
   }
   c.push_back(
+      "not examined: ring-electrode gap harmonics (the seed's centring tolerance) are not in "
+      "the audit's model, so nothing here corrects them");
+  c.push_back(
       "not in the file: the baseline (frequency, damping and its anisotropy, split, "
       "angular gain) is what the estimator identifies online, not a calibration");
   return out;
