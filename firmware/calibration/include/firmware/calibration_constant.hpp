@@ -4,8 +4,10 @@
 // The calibration built into the image (the bare-metal build has no file
 // system): the identity unless the build names a header that defines
 // `kBuiltInCalibration` (cmake -DHRG_CALIBRATION_HEADER=/path/gyro_1234.hpp,
-// a file written from the gyro's TOML). Checked at compile time: a
-// constant outside the physical ranges does not build.
+// written from the gyro's TOML by `hrg calibration-check FILE --header OUT`).
+// Checked at compile time: a constant outside the physical ranges does not
+// build. Internal linkage (constexpr, not inline): each translation unit
+// sees the one its build names.
 
 #include "firmware/calibration.hpp"
 
@@ -13,7 +15,7 @@
 #include HRG_CALIBRATION_HEADER
 #else
 namespace hrg::fw {
-inline constexpr Calibration kBuiltInCalibration = kIdentityCalibration;
+constexpr Calibration kBuiltInCalibration = kIdentityCalibration;
 }  // namespace hrg::fw
 #endif
 

@@ -54,6 +54,11 @@ CalibrationFile load_calibration(const std::string& path);
 // its sigma where given, and the CRC-32 of the canonical form as a comment.
 std::string format_calibration(const CalibrationFile& file, const std::vector<std::string>& header,
                                const std::vector<std::string>& footer);
+// A C++ header defining hrg::fw::kBuiltInCalibration with every field as an
+// exact hexadecimal floating literal (the bare-metal build's constant, see
+// firmware/calibration_constant.hpp); `source` is named in its comment.
+std::string format_calibration_header(const Calibration& c, const std::string& source);
+
 // Writes format_calibration to `path`; throws CalibrationFileError on I/O failure.
 void save_calibration(const std::string& path, const CalibrationFile& file,
                       const std::vector<std::string>& header,
