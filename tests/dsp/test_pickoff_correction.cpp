@@ -98,21 +98,24 @@ TEST(PickoffCorrection, SimulatorsMapThenInverseReturnsTheTruthInDoubleFloatAndQ
     worst_f = std::max(worst_f, max_diff({f.cx, f.sx, f.cy, f.sy}, c.truth));
 
     // Q1.31: input quantisation (0.5 LSB through |kc|+|ks|+|m|), coefficient
-    // quantisation (0.5 * 2^-30 each, times |q| <= 1: 1 LSB each) and the
-    // final rounding (0.5 LSB + 3 * 2^-28).
+    // quantisation (2^-31 each, times the input it multiplies: |q| LSB each
+    // for |q| in full-scale units) and the final rounding (0.5 + 3 * 2^-28 LSB).
     PickoffCorrectionQ30 kq;
     CHECK_TRUE(to_q30(k, kq));
     QuadSample<q31_t> q = to_q31(c.measured);
     CHECK_FALSE(correct_pickoffs_q31(kq, q));
-    const double bound_lsb = 0.5 * (std::fabs(k.kc) + std::fabs(k.ks) + std::fabs(k.m)) +
-                             3.0 * 0.5 + 0.5 + 3.0 / (1 << 28);
+    const auto& m = c.measured;
+    const double inputs = std::max(std::fabs(m.cy) + std::fabs(m.sy) + std::fabs(m.cx),
+                                   std::fabs(m.cy) + std::fabs(m.sy) + std::fabs(m.sx));
+    const double bound_lsb =
+        0.5 * (std::fabs(k.kc) + std::fabs(k.ks) + std::fabs(k.m)) + inputs + 0.5 + 3.0 / (1 << 28);
     const double err_lsb = max_diff(of_q31(q), c.truth) * kQ31One;
     CHECK_TRUE(err_lsb <= bound_lsb);
     worst_q_lsb = std::max(worst_q_lsb, err_lsb);
   }
   CHECK_TRUE(worst_d < 1e-15);
   CHECK_TRUE(worst_f < 3e-7);     // a few float ulps of quadratures <= 0.7
-  CHECK_TRUE(worst_q_lsb < 2.0);  // in practice well inside the 3.1 LSB bound
+  CHECK_TRUE(worst_q_lsb < 2.0);  // in practice well inside the bound (<= 3.1 LSB)
   std::printf("\n  pickoff round trip, max error: double %.2e, float %.2e, Q1.31 %.2f LSB\n",
               worst_d, worst_f, worst_q_lsb);
 }

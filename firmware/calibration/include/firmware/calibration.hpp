@@ -112,4 +112,15 @@ bool pickoff_correction_q30(const Calibration& c, dsp::PickoffCorrectionQ30& out
 // The feedthrough part, V/V.
 dsp::FeedthroughCoefficients<double> feedthrough_coefficients(const Calibration& c);
 
+// The resonator part, as the catalogue defines it, at what the firmware
+// measures (for feed-forward and the estimator's regressors):
+// frequency offset from f_ref_hz (the frequency at T0, small amplitude, pump
+// off), Hz: f_ref alpha (T - T0) + c_duffing a_A^2 + c_spring V_pump^2 (pump on;
+// V_pump its amplitude).
+double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_a_v,
+                           double pump_amplitude_v, bool pump_on);
+// Factor on the whole damping (mean and anisotropy): (1 + beta (T - T0))(1 + eta E),
+// E = a_A^2 + a_B^2 (V^2 of pickoff).
+double damping_scale(const Calibration& c, double temp_c, double e_v2);
+
 }  // namespace hrg::fw

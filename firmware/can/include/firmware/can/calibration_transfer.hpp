@@ -100,7 +100,8 @@ class CalibrationTransfer {
   const Calibration& active() const { return active_; }
   uint32_t active_crc() const { return active_crc_; }
   uint32_t applied_count() const { return applied_; }
-  // Frames answered with each result (index = CalResult value).
+  // Frames handled with each result (index = CalResult value; accepted DATA
+  // frames count as accepted without a reply).
   const std::array<uint32_t, kCalResultCount>& counts() const { return counts_; }
   bool unlocked() const { return state_ == State::unlocked || state_ == State::receiving; }
 
