@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <random>
 
+#include "dsp/pickoff_correction.hpp"
 #include "synthetic_decay.hpp"
 
 #include "support/cpputest.hpp"
@@ -27,8 +28,10 @@ struct Map {
 };
 
 // The measured sample: Y_meas = (1 + g)(cos2b Y + sin2b X), white noise on the
-// four quadratures, wave variables recomputed as the firmware does.
-WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt19937_64& rng) {
+// four quadratures, the correction the firmware applies (if any), wave
+// variables recomputed as the firmware does.
+WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt19937_64& rng,
+                   const hrg::dsp::PickoffCorrection<double>& applied) {
   auto q = hrg::dsp::quadratures_of_wave<double>(s.a_A_v, s.a_B_v, s.theta_rad, 0.3);
   const double c2b = std::cos(2.0 * m.misalignment_rad);
   const double s2b = std::sin(2.0 * m.misalignment_rad);
@@ -41,6 +44,7 @@ WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt199
   q.sx += n(rng);
   q.cy += n(rng);
   q.sy += n(rng);
+  hrg::dsp::correct_pickoffs(applied, q);
   const auto w = hrg::dsp::wave_variables<double>(q);
   return WaveSample{s.t_s, w.a_A, w.a_B, w.theta_A_rad, w.E};
 }
@@ -49,7 +53,8 @@ WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt199
 // rates_dps[w % n], each starting at the set point at a new pattern angle.
 template <std::size_t N>
 PickoffSelfCalResult run_windows(const Map& m, const double (&rates_dps)[N], int windows,
-                                 double max_kappa = kSelfCalMaxKappa) {
+                                 double max_kappa = kSelfCalMaxKappa,
+                                 const hrg::dsp::PickoffCorrection<double>& applied = {}) {
   const ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
   PickoffSelfCalibration cal;
   std::mt19937_64 rng(16);
@@ -58,7 +63,7 @@ PickoffSelfCalResult run_windows(const Map& m, const double (&rates_dps)[N], int
     DecayState s{100.0 * w, 1.0, 1e-3, (13.0 * w) * kDeg};
     CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(cal.begin_window()));
     for (int i = 0; i < 1000; ++i) {
-      cal.add_sample(measure(s, m, 1e-4, rng));
+      cal.add_sample(measure(s, m, 1e-4, rng, applied));
       decay.step(s, 1e-3);
     }
     CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(cal.end_window()));
@@ -93,6 +98,27 @@ TEST(PickoffSelfCalibration, GainAndMisalignmentComeFromTheLevelWhileTheTableTur
   DOUBLES_EQUAL(p(kNu), r.nu_per_s, 0.02 * p(kNu));
   DOUBLES_EQUAL(p(kDnuC), r.dnu_c_per_s, 0.1 * p(kNu) * 0.05);
   DOUBLES_EQUAL(p(kDnuS), r.dnu_s_per_s, 0.1 * p(kNu) * 0.05);
+}
+
+TEST(PickoffSelfCalibration, AppliedAndIdentifiedAgainTheResidualMapVanishes) {
+  // The firmware applies the identified inverse and keeps identifying on the
+  // corrected signals: what is left is the first pass's O(g^2) bias, which
+  // the second pass sees and removes.
+  const Map truth{0.01, 0.5 * kDeg};
+  const PickoffSelfCalResult r1 = run_windows(truth, kMixedRates, 40);
+  hrg::dsp::PickoffCorrection<double> k1;
+  CHECK_TRUE(hrg::dsp::pickoff_correction_of({r1.gain, 0.0, r1.misalignment_rad}, k1));
+  const PickoffSelfCalResult r2 = run_windows(truth, kMixedRates, 40, kSelfCalMaxKappa, k1);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r2.status));
+  // Total map identified: (1 + g1)(1 + g2) - 1 and b1 + b2 (to first order).
+  const double g = (1.0 + r1.gain) * (1.0 + r2.gain) - 1.0;
+  const double b = r1.misalignment_rad + r2.misalignment_rad;
+  std::printf(
+      "\n  second pass on corrected signals: residual g %.1e +- %.1e, b %.1e deg; total g "
+      "%.6f, b %.5f deg\n",
+      r2.gain, r2.gain_sigma, r2.misalignment_rad / kDeg, g, b / kDeg);
+  CHECK_TRUE(std::fabs(g - truth.gain) < 3.0 * r2.gain_sigma + 5e-6);
+  CHECK_TRUE(std::fabs(b - truth.misalignment_rad) < 3.0 * r2.misalignment_sigma_rad + 5e-6);
 }
 
 TEST(PickoffSelfCalibration, AnIdealPickoffGivesZeroWithinItsSigma) {
