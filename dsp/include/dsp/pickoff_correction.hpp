@@ -136,7 +136,10 @@ bool feedthrough_to_q31(const FeedthroughCoefficients<double>& k_v_per_v, double
 // the pump is off) makes the removal right at the switching instants too,
 // up to the 2f mixing product of the step, which the sinc^3 nulls only for
 // a steady envelope (1.6 % of the step in the test at the default block,
-// for one block).
+// for one block). In the chain the DAC block written after ADC block n acts
+// from frame (n + 1) L + 0.5 (ChainConfig::dac_lead_frames): the envelope of
+// ADC block n is the pump (V0, phase against the NCO) the chain synthesised
+// one block earlier; the half frame is left out (0.5 % of a step).
 class PumpEnvelopeFilter {
  public:
   explicit PumpEnvelopeFilter(uint32_t block_frames);
