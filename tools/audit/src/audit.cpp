@@ -238,6 +238,7 @@ AuditResult Auditor::run(PlotData* plot) {
   }
   const State baseline = cur;
   out.noise_v = d_.noise_v;
+  out.temp_ref_c = d_.temp_ref_c;
   out.free_segments = static_cast<int>(d_.free.size());
   out.forced_segments = static_cast<int>(d_.forced.size());
   out.blocks = static_cast<int>(d_.blocks.size());
@@ -389,6 +390,7 @@ AuditResult Auditor::run(PlotData* plot) {
       ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
       f.value = std::max(ft.c_x, ft.c_y);
       f.sigma = ft.sigma;
+      f.feedthrough_re_im = ft.c_re_im;
     } else {
       const auto pi = static_cast<std::size_t>(param_of(chosen[i]));
       f.value = to_catalogue(chosen[i], cur.fit.p[pi]);
