@@ -2,11 +2,12 @@
 #include "dsp/chain.hpp"
 
 #include <cmath>
+#include <numbers>
 
 namespace hrg::dsp {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 double clamp_abs(double v, double lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
 double wrap_pi(double a) { return a - 2.0 * kPi * std::round(a / (2.0 * kPi)); }

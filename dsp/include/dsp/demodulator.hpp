@@ -37,6 +37,7 @@
 //   within 1 LSB + 1 LSB of the exact filter of the rounded products.
 
 #include <array>
+#include <numbers>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -61,7 +62,7 @@ struct QuadSample {
 // 20 log10 |sin(pi f L / fs) / (L sin(pi f / fs))|^3. For the 2f image pass
 // f = 2 f_resonance.
 inline double image_rejection_db(double f_hz, double fs_hz, uint32_t block_frames) {
-  const double pi = 3.14159265358979323846;
+  const double pi = std::numbers::pi;
   const double l = static_cast<double>(block_frames);
   const double den = l * std::sin(pi * f_hz / fs_hz);
   if (den == 0.0) return 0.0;

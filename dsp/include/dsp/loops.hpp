@@ -9,6 +9,7 @@
 // Task context, once per block; no allocation.
 
 #include <cmath>
+#include <numbers>
 #include <cstdint>
 
 namespace hrg::dsp {
@@ -116,10 +117,10 @@ class Pll {
 
   void configure(const Config& c) {
     cfg_ = c;
-    const double wn = 2.0 * 3.14159265358979323846 * c.natural_hz;
-    const double w_c = 2.0 * 3.14159265358979323846 * c.f_center_hz;
-    const double w_min = 2.0 * 3.14159265358979323846 * c.f_min_hz;
-    const double w_max = 2.0 * 3.14159265358979323846 * c.f_max_hz;
+    const double wn = 2.0 * std::numbers::pi * c.natural_hz;
+    const double w_c = 2.0 * std::numbers::pi * c.f_center_hz;
+    const double w_min = 2.0 * std::numbers::pi * c.f_min_hz;
+    const double w_max = 2.0 * std::numbers::pi * c.f_max_hz;
     pi_.configure(2.0 * c.damping * wn, wn * wn, w_min - w_c, w_max - w_c);
     reset();
   }
@@ -134,7 +135,7 @@ class Pll {
   double update(double phase_err_rad, bool valid, double dt_s) {
     if (valid) {
       const double dw = pi_.update(phase_err_rad, dt_s);
-      f_hz_ = cfg_.f_center_hz + dw / (2.0 * 3.14159265358979323846);
+      f_hz_ = cfg_.f_center_hz + dw / (2.0 * std::numbers::pi);
     }
     return f_hz_;
   }
@@ -161,7 +162,7 @@ class Agc {
     double nu_per_s = 3.14159e-3;  // nominal damping (feed-forward), 1/s
     double natural_rad_s = 8.0;    // loop natural frequency
     double damping = 1.0;
-    double omega_rad_s = 2.0 * 3.14159265358979323846 * 5000.0;
+    double omega_rad_s = 2.0 * std::numbers::pi * 5000.0;
     double pump_gain_per_s2_v2 = 87.73;  // k_pump
     double pump_max_v = 10.0;            // V0 limit
   };

@@ -12,6 +12,7 @@
 // phases for every type.
 
 #include <array>
+#include <numbers>
 #include <cstddef>
 #include <cstdint>
 
@@ -22,7 +23,7 @@ namespace hrg::dsp {
 
 namespace detail {
 
-inline constexpr double kPi = 3.14159265358979323846264338327950288;
+inline constexpr double kPi = std::numbers::pi;
 
 // sin(x) for 0 <= x <= pi/2 by its Taylor series (27th order: error below
 // 1e-17 at pi/2); evaluated by the compiler, so host and target tables match.

@@ -124,8 +124,7 @@ Status StreamAdc::adopt(int fd, const StreamConfig& config, MonotonicClock& cloc
   return Status::ok;
 }
 
-Status StreamAdc::read_block(std::span<q31_t> frames, uint64_t& t_first_ns,
-                             uint32_t& clipped) {
+Status StreamAdc::read_block(std::span<q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped) {
   if (fd_ < 0) return Status::closed;
   if (frames.size() != static_cast<std::size_t>(config_.info.block_frames) * kAdcChannels) {
     return Status::invalid_argument;

@@ -114,8 +114,7 @@ class SimTarget {
   };
   using DacFrame = std::array<hal::q31_t, hal::kDacChannels>;
 
-  hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns,
-                            uint32_t& clipped);
+  hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped);
   Drive next_drive();
   uint64_t sample_time_ns(uint64_t index) const;
 

@@ -25,8 +25,8 @@ void accumulate_errors(JobResult& r, const JobConfig& job) {
   double model_deg = 0, bound_deg = 0, raw_err = 0, out_err = 0;
   double control_sum = 0;
   std::size_t control_n = 0;
-  const Row* prev = nullptr;
-  for (Row& row : r.rows) {
+  const TelemetryRow* prev = nullptr;
+  for (TelemetryRow& row : r.rows) {
     if (row.out_valid && prev != nullptr && prev->out_valid) {
       const double d_true = row.true_angle_deg - prev->true_angle_deg;
       raw_err += row.raw_angle_deg - prev->raw_angle_deg - d_true;
@@ -59,10 +59,10 @@ void accumulate_errors(JobResult& r, const JobConfig& job) {
 // b + A sin 4theta + B cos 4theta fits.
 void parked_bias(JobResult& r, const JobConfig& job) {
   std::vector<double> th, braw, bcomp, bmodel;
-  for (const Park& p : job.parks) {
+  for (const ParkedInterval& p : job.parks) {
     std::vector<double> t, eraw, ecomp;
     double model = 0, theta_sum = 0;
-    for (const Row& row : r.rows) {
+    for (const TelemetryRow& row : r.rows) {
       if (row.t_s < p.t_begin_s || row.t_s > p.t_end_s || !row.out_valid) continue;
       t.push_back(row.t_s);
       eraw.push_back(row.raw_angle_deg - row.true_angle_deg);

@@ -2,6 +2,7 @@
 #include "sim_tools/report.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <fstream>
 #include <stdexcept>
 
@@ -12,7 +13,7 @@
 namespace hrg::simtools {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 constexpr const char* kParamNames[5] = {"nu_per_s", "dnu_c_per_s", "dnu_s_per_s", "dw_c_rad_s",
                                         "dw_s_rad_s"};
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
@@ -228,7 +229,7 @@ const std::vector<std::string>& telemetry_columns() {
 }
 
 // One row's values in telemetry_columns() order.
-void telemetry_values(const Row& row, std::vector<double>& v) {
+void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
   v = {row.t_s,
        row.cx_v,
        row.sx_v,
@@ -269,7 +270,7 @@ void write_telemetry(const std::filesystem::path& path, const JobConfig& job, co
   recording::RecordingWriter wr(path, telemetry_columns(), job.firmware.chain.f_center_hz,
                                 job.firmware.gyro.angular_gain, telemetry_metadata(job));
   std::vector<double> v;
-  for (const Row& row : r.rows) {
+  for (const TelemetryRow& row : r.rows) {
     telemetry_values(row, v);
     wr.write_row(v);
   }
@@ -282,7 +283,7 @@ recording::Recording telemetry_recording(const JobConfig& job, const JobResult& 
   for (const auto& [key, value] : telemetry_metadata(job))
     rec.set_metadata(key, value);
   std::vector<double> v;
-  for (const Row& row : r.rows) {
+  for (const TelemetryRow& row : r.rows) {
     telemetry_values(row, v);
     rec.append_row(v);
   }

@@ -193,7 +193,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const Row
   const fw::ChainRecord& ch = st.chain;
   const sim::TrueState ts = stamp.truth();
   const double k = job.firmware.gyro.angular_gain;
-  Row row{};
+  TelemetryRow row{};
   row.t_s = ts.t_s;
   // The chain demodulates against its NCO, whose phase the PLL moves every
   // block. The recording's cx..sy are against the fixed metadata reference

@@ -14,7 +14,7 @@ namespace hrg::simtools {
 
 // One parked interval of the angle-dependent-bias test: the case is still,
 // the pattern sits at one angle, and the bias is the slope of the angle error.
-struct Park {
+struct ParkedInterval {
   double t_begin_s = 0.0;  // measurement starts (after the settle time)
   double t_end_s = 0.0;
 };
@@ -35,11 +35,11 @@ struct JobConfig {
   fw::app::FirmwareConfig firmware;  // derived from `sim` by derive_firmware_config
   double duration_s = 0.0;
   double latitude_deg = 55.75;
-  double earth_rate_rad_s = 0.0;   // vertical component of the Earth rate in the input
-  double telemetry_hz = 100.0;     // rows of telemetry.csv per simulated second
-  double sweep_end_s = 0.0;        // end of the turning (identification) phase
-  std::vector<Park> parks;         // the bias test (empty: none)
-  std::vector<FaultEvent> faults;  // in time order
+  double earth_rate_rad_s = 0.0;      // vertical component of the Earth rate in the input
+  double telemetry_hz = 100.0;        // rows of telemetry.csv per simulated second
+  double sweep_end_s = 0.0;           // end of the turning (identification) phase
+  std::vector<ParkedInterval> parks;  // the bias test (empty: none)
+  std::vector<FaultEvent> faults;     // in time order
   std::string description;
 };
 
@@ -66,7 +66,7 @@ fw::ConverterLayout converter_layout(const sim::SimConfig& sim);
 void derive_firmware_config(JobConfig& job);
 
 // One telemetry row (the recording's columns plus the truth).
-struct Row {
+struct TelemetryRow {
   double t_s, cx_v, sx_v, cy_v, sy_v;
   int exc;             // 1 unless the row's whole averaging span was free of drive
   int excitation_cmd;  // the firmware's excitation command for this block
@@ -131,7 +131,7 @@ struct JobResult {
   double noise_sigma_v = 0.0;
   double t_converged_s = -1.0;          // the window campaign ended (model applied)
   double control_drift_mean_dph = 0.0;  // mean D_Phi/K added over the valid output
-  std::vector<Row> rows;
+  std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
   std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
