@@ -290,6 +290,7 @@ void Gyro::task_telemetry(Gyro& g) {
   s.exc_line = st.enable_line;
   s.fault_input = st.fault_input;
   s.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
+  s.comp_valid = st.compensation_valid;
   s.faults = static_cast<uint16_t>(st.faults | g.mode_.faults());
   const Identification id = g.identifier_.identification();
   s.nu_per_s = id.p[0];

@@ -45,6 +45,7 @@ constexpr SignalDef kStatus[] = {
   {"exc_line", 9, 1, false, 1, 0, 0, 1, ""},
   {"fault_input", 10, 1, false, 1, 0, 0, 1, ""},
   {"ident_active", 11, 1, false, 1, 0, 0, 1, ""},
+  {"comp_valid", 12, 1, false, 1, 0, 0, 1, ""},
   {"faults", 16, 16, false, 1, 0, 0, 65535, ""},
   {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
   {"seq", 48, 8, false, 1, 0, 0, 255, ""},

@@ -76,6 +76,7 @@ enum Status : uint8_t {
   exc_line,
   fault_input,
   ident_active,
+  comp_valid,
   faults,
   temp_c,
   status_seq
