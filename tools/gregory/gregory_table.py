@@ -152,8 +152,8 @@ def main():
     with cf.ThreadPoolExecutor(a.jobs) as ex:
         res = {r[0]: r[1:] for r in ex.map(lambda n: run_row(a.hrg, a.scenario, a.work, n), names)}
     clean = res["none"][0]["comp"]
-    print("| effect | raw | seed model | (valid) | after audit round | clean | readout before | after | audit verdict | goals |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| effect | raw | seed model | (valid) | after audit round | (valid) | clean | readout before | after | audit verdict | goals |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     missed = []
     for n in names:
         b, c, verdict = res[n]
@@ -163,12 +163,16 @@ def main():
                 goals.append("after %.3g > 2x clean %.3g" % (c["comp"], 2.0 * clean))
             if not c["comp"] * 20.0 <= b["raw"]:
                 goals.append("after not 20x below raw")
+            if not c["valid"]:
+                goals.append("after: compensation not valid")
             if ROWS[n][1] and not c["readout"] <= 0.01:
                 goals.append("readout %.3g deg > 0.01" % c["readout"])
-        if b["valid"] and b["comp"] > b["raw"]:
-            goals.append("valid compensation worse than raw")
-        print("| %s | %.3g | %.3g | %s | %.3g | %.3g | %.3g | %.3g | %s | %s |" % (
-            n, b["raw"], b["comp"], "yes" if b["valid"] else "NO", c["comp"], clean,
+        for run in (b, c):
+            if run["valid"] and run["comp"] > run["raw"]:
+                goals.append("valid compensation worse than raw")
+        print("| %s | %.3g | %.3g | %s | %.3g | %s | %.3g | %.3g | %.3g | %s | %s |" % (
+            n, b["raw"], b["comp"], "yes" if b["valid"] else "NO", c["comp"],
+            "yes" if c["valid"] else "NO", clean,
             b["readout"], c["readout"], verdict, "; ".join(goals) if goals else "met"))
         if goals:
             missed.append(n)
