@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 
+#include "dsp/electronics_correction.hpp"
 #include "dsp/pickoff_correction.hpp"
 
 using namespace hrg::dsp;
@@ -66,10 +68,40 @@ extern "C" __attribute__((noinline)) double hrg_bench_feedthrough_f64(int calls)
   return sum;
 }
 
+// The chain's whole stage (pump envelope filter, feedthrough, pickoff
+// inverse) as dsp::Chain runs it once per block.
+template <typename T>
+double stage(int calls) {
+  ElectronicsCorrection<T> c(100);
+  c.configure(coefficients(), {8.66e-4, 5e-4, -2.5e-4, 4.3e-4}, 2.0, 10.0);
+  double sum = 0.0;
+  for (int i = 0; i < calls; ++i) {
+    QuadSample<T> q{};
+    if constexpr (std::is_same_v<T, q31_t>) {
+      q = {i * 977, -i * 131, i * 313, 1 << 29};
+    } else {
+      q = {T(i * 1e-6), T(-i * 2e-7), T(0.3), T(i * 3e-7)};
+    }
+    c.apply(5.0, i * 1e-3, q);
+    sum += static_cast<double>(q.cx) + static_cast<double>(q.sy);
+  }
+  return sum;
+}
+
+extern "C" __attribute__((noinline)) double hrg_bench_stage_q31(int calls) {
+  return stage<q31_t>(calls);
+}
+
+extern "C" __attribute__((noinline)) double hrg_bench_stage_f32(int calls) {
+  return stage<float>(calls);
+}
+
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: %s pickoff_q31|pickoff_f64|feedthrough_q31|feedthrough_f64 N\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s pickoff_q31|pickoff_f64|feedthrough_q31|feedthrough_f64|stage_q31|stage_f32 N\n",
+        argv[0]);
     return 2;
   }
   const int calls = std::atoi(argv[2]);
@@ -82,6 +114,10 @@ int main(int argc, char** argv) {
     r = hrg_bench_feedthrough_q31(calls);
   } else if (std::strcmp(argv[1], "feedthrough_f64") == 0) {
     r = hrg_bench_feedthrough_f64(calls);
+  } else if (std::strcmp(argv[1], "stage_q31") == 0) {
+    r = hrg_bench_stage_q31(calls);
+  } else if (std::strcmp(argv[1], "stage_f32") == 0) {
+    r = hrg_bench_stage_f32(calls);
   } else {
     std::fprintf(stderr, "unknown mode '%s'\n", argv[1]);
     return 2;
