@@ -197,6 +197,9 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   w.boolean("applied", r.compensation_applied);
   w.integer("model_checks_failed", r.model_checks_failed);
   w.number("last_window_misfit", r.last_window_misfit);
+  // The calibration in force (CRC-32 of its canonical form, as hrg
+  // calibration-check prints it; that of the identity when none was given).
+  w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);
