@@ -125,7 +125,8 @@ const char* check_chain_config(const ChainConfig& c) {
 }
 
 template <typename T>
-Chain<T>::Chain(const ChainConfig& cfg) : cfg_(cfg), demod_(cfg.block_frames) {
+Chain<T>::Chain(const ChainConfig& cfg)
+    : cfg_(cfg), demod_(cfg.block_frames), correction_(cfg.block_frames) {
   usable_ = check_chain_config(cfg) == nullptr;
   if (!usable_) return;
   const double w = 2.0 * kPi * cfg.f_center_hz;
@@ -146,6 +147,8 @@ Chain<T>::Chain(const ChainConfig& cfg) : cfg_(cfg), demod_(cfg.block_frames) {
 template <typename T>
 void Chain<T>::reset() {
   demod_.reset();
+  correction_.reset();
+  pump_env_re_v_ = pump_env_im_v_ = 0.0;
   pll_.reset();
   lock_.reset();
   agc_.reset();
@@ -183,6 +186,8 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
   const uint32_t phase_block_start = phase_;
   QuadSample<T> qs;
   demod_.process_block(adc, phase_, step_, qs);
+  // The pump written after the previous ADC block acted during this one.
+  correction_.apply(pump_env_re_v_, pump_env_im_v_, qs);
 
   const double fs_v = cfg_.adc_full_scale_v;
   const Quadratures<double> q{Ops::to_f64(qs.cx) * fs_v, Ops::to_f64(qs.sx) * fs_v,
@@ -198,6 +203,8 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
   update_loops(w, dt_s);
   update_drift_inputs(had_pump_phase, prev_pump_phase_rad);
   have_pump_phase_ = true;
+  pump_env_re_v_ = v0_v_ * std::cos(out_.pump_phase_rad);
+  pump_env_im_v_ = v0_v_ * std::sin(out_.pump_phase_rad);
   step_ = phase_step_of_hz(out_.pll_freq_hz, cfg_.sample_rate_hz);
   synthesize(phase_block_start, dac);
   ++out_.blocks;

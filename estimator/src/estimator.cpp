@@ -5,13 +5,29 @@
 
 namespace hrg::est {
 
-Status Estimator::end_window() {
+Status Estimator::end_window(bool fold) {
   const Status s = window_.end_window(scratch_);
-  if (s == Status::ok) ls_.add_window(scratch_);
+  if (s == Status::ok) {
+    check_window(scratch_);
+    if (fold) ls_.add_window(scratch_);
+  }
   // The loops re-acquire after the window: the D_Phi derivatives restart.
   control_.restart();
   pump_.restart();
   return s;
+}
+
+void Estimator::check_window(const WindowContribution& w) {
+  const double var = last_.sigma_hat_v * last_.sigma_hat_v;
+  const double dof = w.rows - w.intercepts;
+  if (!comp_.has_model() || !(var > 0.0) || !(dof > 0.0)) return;
+  // RSS of this window alone at the accepted p: y'y - 2 p'H'y + p'H'H p.
+  const ParamVector& p = comp_.model();
+  const ParamVector b = w.info.block<kParams, 1>(0, kParams);
+  const ParamMatrix n = w.info.block<kParams, kParams>(0, 0);
+  const double rss = w.info(kParams, kParams) - 2.0 * p.dot(b) + p.dot(n * p);
+  last_misfit_ = rss / dof / var;
+  ++windows_checked_;
 }
 
 Solution Estimator::solve_and_accept() {

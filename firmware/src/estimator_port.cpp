@@ -22,6 +22,18 @@ void EstimatorPort::end_window() {
   if (est_.end_window() == est::Status::ok) {
     ++windows_ok_;
     dirty_ = true;
+    health_.window_misfit = est_.last_window_misfit();
+    health_.windows_checked = est_.windows_checked();
+  } else {
+    ++windows_bad_;
+  }
+}
+
+void EstimatorPort::end_check_window() {
+  if (est_.end_window(false) == est::Status::ok) {
+    ++windows_ok_;  // accepted as a check (nothing new to solve)
+    health_.window_misfit = est_.last_window_misfit();
+    health_.windows_checked = est_.windows_checked();
   } else {
     ++windows_bad_;
   }

@@ -186,7 +186,11 @@ void Gyro::on_mode_change(Mode from, Mode to) {
   if (to == Mode::free_decay) identifier_.begin_window(status_.chain.t_s);
   if (from == Mode::free_decay) {
     if (to == Mode::recover) {
-      identifier_.end_window();
+      if (compensation_ready_) {
+        identifier_.end_check_window();
+      } else {
+        identifier_.end_window();
+      }
     } else {
       identifier_.abort_window();
     }
@@ -218,16 +222,12 @@ void Gyro::task_output(Gyro& g) {
   // The model is applied once the campaign has ended (conditioning and
   // coverage good): an early solution from a few windows at nearby angles
   // would add more error than it removes.
-  if (g.cfg_.identify ? g.scheduler_.campaign_done() : g.identifier_.health().solved) {
-    g.compensation_ready_ = true;
-  }
-  double drift = g.cfg_.compensate_drift && g.compensation_ready_
-                     ? g.identifier_.drift_rad_s(o.theta_A_rad, ratio)
-                     : 0.0;
+  g.check_model();
+  const bool apply = g.cfg_.compensate_drift && g.status_.compensation_applied;
+  double drift = apply ? g.identifier_.drift_rad_s(o.theta_A_rad, ratio) : 0.0;
   // The control loops drift the pattern only while they drive it.
   double control = 0.0;
-  if (g.cfg_.compensate_drift && g.cfg_.compensate_control_drift && g.compensation_ready_ &&
-      g.status_.excitation_on) {
+  if (apply && g.cfg_.compensate_control_drift && g.status_.excitation_on) {
     control = g.identifier_.control_drift_rad_s(o.theta_A_rad);
   }
   drift += control;
@@ -241,6 +241,30 @@ void Gyro::task_output(Gyro& g) {
   s.out_raw_angle_rad = g.output_.raw_angle_rad();
   s.out_rate_rad_s = g.output_.rate_rad_s();
   s.out_valid = g.output_.valid();
+}
+
+void Gyro::check_model() {
+  const EstimatorHealth h = identifier_.health();
+  if (!compensation_ready_) {
+    if (!(cfg_.identify ? scheduler_.campaign_done() : h.solved)) return;
+    compensation_ready_ = true;
+    checks_seen_ = h.windows_checked;  // the campaign's own windows prove nothing
+  }
+  if (h.windows_checked != checks_seen_) {
+    checks_seen_ = h.windows_checked;
+    if (h.window_misfit <= cfg_.max_window_misfit) {
+      ++checks_passed_;
+    } else {
+      ++status_.model_checks_failed;
+    }
+  }
+  // In force from the end of the campaign (its conditioning and coverage
+  // are good) until a check window disagrees; then withdrawn for good.
+  // Reported valid only once a check window (on a still base first, where
+  // a fit made while turning is most likely wrong) agreed with it.
+  status_.compensation_applied = status_.model_checks_failed == 0;
+  const bool checked = cfg_.identify && cfg_.windows.check_period_frames != 0;
+  status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0);
 }
 
 void Gyro::task_solve(Gyro& g) {
@@ -266,6 +290,7 @@ void Gyro::task_telemetry(Gyro& g) {
   s.exc_line = st.enable_line;
   s.fault_input = st.fault_input;
   s.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
+  s.comp_valid = st.compensation_valid;
   s.faults = static_cast<uint16_t>(st.faults | g.mode_.faults());
   const Identification id = g.identifier_.identification();
   s.nu_per_s = id.p[0];

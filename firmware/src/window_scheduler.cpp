@@ -50,6 +50,15 @@ double WindowScheduler::excitation_off_fraction() const {
   return frames_ == 0 ? 0.0 : static_cast<double>(off_frames_) / static_cast<double>(frames_);
 }
 
+void WindowScheduler::open(uint32_t bin, WindowDecision& d) {
+  d.open = true;
+  in_window_ = true;
+  in_window_frames_ = 0;
+  window_bin_ = bin;
+  since_start_ = 0;
+  moving_ = false;
+}
+
 WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
                                      const EstimatorHealth& health) {
   WindowDecision d;
@@ -82,7 +91,24 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
     since_done_ = 0;
   }
   if (done_) {
-    if (cfg_.refresh_period_frames == 0 || ++since_done_ < cfg_.refresh_period_frames) return d;
+    const bool refresh =
+        cfg_.refresh_period_frames != 0 && ++since_done_ >= cfg_.refresh_period_frames;
+    if (!refresh) {
+      // Check windows: the model in force is tested against new free decays
+      // (at whatever turn rate and temperature the gyro now sees), and the
+      // first time the base has been still for a window period, at once
+      // (what a fit on a turning base absorbs shows on a still one).
+      const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
+      static_frames_ = is_static ? static_frames_ + 1 : 0;
+      const bool due = since_start_ >= cfg_.check_period_frames ||
+                       (!static_checked_ && static_frames_ >= cfg_.period_frames &&
+                        since_start_ >= cfg_.period_frames);
+      if (cfg_.check_period_frames != 0 && mode == Mode::operate && due) {
+        open(bin_of(theta_rad), d);
+        static_checked_ = static_checked_ || is_static;
+      }
+      return d;
+    }
     counts_ = {};
     done_ = false;
   }
@@ -95,12 +121,7 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
     const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
     if (under_covered(bin) || (!is_static && !moving_ && since_start_ >= cfg_.max_wait_frames) ||
         (is_static && !cfg_.rotate_on_static_base && since_start_ >= cfg_.max_wait_frames)) {
-      d.open = true;
-      in_window_ = true;
-      in_window_frames_ = 0;
-      window_bin_ = bin;
-      since_start_ = 0;
-      moving_ = false;
+      open(bin, d);
       return d;
     }
     if (!moving_ && is_static && cfg_.rotate_on_static_base) {

@@ -201,3 +201,31 @@ TEST(WindowScheduler, OnAStaticBaseThePatternWalksToTheNearestEmptyBin) {
   LONGS_EQUAL(2, l.s.bin_of(d.pattern_target_rad));
   DOUBLES_EQUAL(2.5 * kPi / 16, d.pattern_target_rad, 1e-12);
 }
+
+TEST(WindowScheduler, AfterTheCampaignCheckWindowsRunAtTheirPeriodAndOnceTheBaseIsStill) {
+  WindowConfig c = small_config();
+  c.check_period_frames = 500;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  for (int f = 0; f < 200; ++f)  // turning: the campaign ends on the estimator's word
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  // Still turning: one check window per check period (1000 frames -> 2).
+  uint32_t before = l.opened;
+  for (int f = 0; f < 1000; ++f)
+    l.frame(10.0 + 0.05 * f, 2.0, good);
+  LONGS_EQUAL(before + 2, l.opened);
+  // The base stops: a check window once it has been still for a window
+  // period (50 frames), long before the next check period.
+  before = l.opened;
+  int first = -1;
+  for (int f = 0; f < 400 && first < 0; ++f) {
+    if (l.frame(1.0, 0.0, good).open) first = f;
+  }
+  LONGS_EQUAL(49, first);  // the 50th still frame
+  // ... and only once: the next one waits for the period again.
+  for (int f = 0; f < 400; ++f)
+    l.frame(1.0, 0.0, good);
+  LONGS_EQUAL(before + 1, l.opened);
+  CHECK(l.s.campaign_done());
+}

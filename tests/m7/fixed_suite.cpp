@@ -16,6 +16,7 @@
 #include "dsp/demodulator.hpp"
 #include "dsp/fixed.hpp"
 #include "dsp/nco.hpp"
+#include "dsp/pickoff_correction.hpp"
 #include "report.hpp"
 
 namespace hrg::m7 {
@@ -206,6 +207,44 @@ void chain_on_synthetic_blocks(Report& r) {
   r.check(zero, "chain drives exactly zero with excitation off");
 }
 
+// The electronics corrections (dsp/pickoff_correction.hpp) on pseudo-random
+// quadratures and at the rails. Coefficients are given as words (no libm),
+// so both platforms run the same bits; every output goes into the digest.
+void electronics_corrections(Report& r) {
+  // g = 0.01, phase 1 deg, misalignment 0.5 deg; feedthrough ~1e-3 V/V
+  // (scaled by 10 V / 2 V); and the -2 extremes.
+  const PickoffCorrectionQ30 k{1063110717, 18556667, -18742233};
+  const PickoffCorrectionQ30 worst{INT32_MIN, INT32_MIN, INT32_MIN};
+  const FeedthroughCoefficients<q31_t> ft{9298604, 5368709, -2684355, 4649302};
+  Lcg noise;
+  int saturated = 0;
+  for (int i = 0; i < 2000; ++i) {
+    QuadSample<q31_t> q{noise.next(0x3FFFFFFF), noise.next(0x3FFFFFFF), noise.next(0x3FFFFFFF),
+                        noise.next(0x3FFFFFFF)};
+    const q31_t pump_re = noise.next(0x7FFFFFFF);  // sequenced: argument order is unspecified
+    const q31_t pump_im = noise.next(0x7FFFFFFF);
+    saturated += remove_feedthrough_q31(ft, pump_re, pump_im, q);
+    saturated += correct_pickoffs_q31(k, q);
+    r.digest_word(q.cx);
+    r.digest_word(q.sx);
+    r.digest_word(q.cy);
+    r.digest_word(q.sy);
+  }
+  r.check(saturated == 0, "corrections of half-scale quadratures do not saturate");
+  const std::array<q31_t, 6> rails{INT32_MIN, INT32_MIN + 1, -1, 0, 1, INT32_MAX};
+  for (q31_t v : rails) {
+    QuadSample<q31_t> q{v, v, v, v};
+    const bool sat = correct_pickoffs_q31(worst, q);
+    remove_feedthrough_q31({INT32_MIN, INT32_MIN, INT32_MIN, INT32_MIN}, v, v, q);
+    r.digest_word(q.cy);
+    r.digest_word(q.sy);
+    r.digest_word(q.cx);
+    r.digest_word(q.sx);
+    r.check(sat == (v == INT32_MIN || v == INT32_MAX || v == INT32_MIN + 1),
+            "pickoff correction saturates at the rails only");
+  }
+}
+
 }  // namespace
 
 int run_fixed_suite(Report& r) {
@@ -215,6 +254,7 @@ int run_fixed_suite(Report& r) {
   nco_wraps(r);
   demodulator_matches_reference(r);
   chain_on_synthetic_blocks(r);
+  electronics_corrections(r);
   r.figure("checks", r.checks());
   r.figure("failures", r.failures());
   r.text("digest: ");

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "can/dbc.hpp"
+#include "firmware/can/calibration_transfer.hpp"
 #include "firmware/can/command.hpp"
 #include "firmware/can/messages.hpp"
 #include "firmware/can/telemetry.hpp"
@@ -84,10 +85,13 @@ TEST(DbcAgreesWithCode, EveryMessageAndSignalOfTheCodeIsInTheDbc) {
   for (const auto& m : kCommands)
     check_message(m, dbc());
   check_message(kReply, dbc());
+  for (const auto& m : kCalibrationMessages)
+    check_message(m, dbc());
 }
 
 TEST(DbcAgreesWithCode, TheDbcHasNoMessageTheCodeDoesNotKnow) {
-  LONGS_EQUAL(kTelemetryCount + kCommandCount + 1, dbc().messages.size());
+  LONGS_EQUAL(kTelemetryCount + kCommandCount + 1 + kCalibrationMessageCount,
+              dbc().messages.size());
   for (const auto& m : dbc().messages)
     CHECK_TEXT(find_message(m.id) != nullptr, m.name.c_str());
 }
@@ -102,6 +106,11 @@ TEST(DbcAgreesWithCode, ModeValuesInTheDbcAreTheFirmwareModes) {
   const auto& results = dbc().message("HRG_CMD_REPLY")->signal("result")->values;
   for (int r = 0; r <= 8; ++r) {
     STRCMP_EQUAL(to_string(static_cast<CommandResult>(r)), results.at(r).c_str());
+  }
+  const auto& cal = dbc().message("HRG_CAL_REPLY")->signal("result")->values;
+  LONGS_EQUAL(kCalResultCount, cal.size());
+  for (int r = 0; r < static_cast<int>(kCalResultCount); ++r) {
+    STRCMP_EQUAL(to_string(static_cast<CalResult>(r)), cal.at(r).c_str());
   }
 }
 

@@ -3,10 +3,12 @@
 // simulated converters of sim_target behind the ADC/DAC seam (no hardware
 // needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
+//             [--calibration FILE]
 // The firmware sends its telemetry on IF at the default rates, answers the
 // commands of the DBC and restarts the controller after 100 ms of bus-off, all
 // through its own CAN link (receive filter set at start). Runs until
-// SIGTERM/SIGINT or S seconds.
+// SIGTERM/SIGINT or S seconds. --calibration FILE (hrg audit --calibration)
+// puts that calibration in force from the start.
 #include <signal.h>
 
 #include <cmath>
@@ -14,10 +16,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <string>
 
 #include "firmware/app/firmware.hpp"
+#include "firmware/calibration_file.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
@@ -39,12 +43,13 @@ struct Options {
   unsigned exc_line = 0;
   unsigned fault_line = 1;
   double seconds = 1e9;
+  std::string calibration;  // empty: the identity
 };
 
 int usage() {
   std::fprintf(stderr,
                "usage: hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] "
-               "[--seconds S]\n");
+               "[--seconds S] [--calibration FILE]\n");
   return 2;
 }
 
@@ -63,6 +68,8 @@ bool parse(int argc, char** argv, Options& o) {
       o.fault_line = static_cast<unsigned>(std::atoi(v));
     } else if (a == "--seconds") {
       o.seconds = std::atof(v);
+    } else if (a == "--calibration") {
+      o.calibration = v;
     } else {
       return false;
     }
@@ -77,6 +84,14 @@ int main(int argc, char** argv) {
   if (!parse(argc, argv, o)) return usage();
 
   simtools::JobConfig job = simtools::default_job(o.seconds > 3600 ? 3600 : o.seconds, 0);
+  if (!o.calibration.empty()) {
+    try {
+      job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "hrg-board: %s\n", e.what());
+      return 2;
+    }
+  }
   sim::SimTarget& sim = sim::target();
   sim.configure(job.sim);
   hal::Board& sim_board = sim.board();

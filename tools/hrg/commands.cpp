@@ -9,11 +9,12 @@
 
 namespace hrg::cli {
 
-int scenario_check_main(std::span<char* const> args);  // scenario_check_command.cpp
-int characterize_main(std::span<char* const> args);    // characterize_command.cpp
+int scenario_check_main(std::span<char* const> args);     // scenario_check_command.cpp
+int characterize_main(std::span<char* const> args);       // characterize_command.cpp
+int calibration_check_main(std::span<char* const> args);  // calibration_check_command.cpp
 
 namespace {
-constexpr std::array<Command, 6> kCommands{{
+constexpr std::array<Command, 7> kCommands{{
     {"sim", "run the firmware against the simulated gyro (the main job)", &sim_main},
     {"audit", "locate sim/recording mismatches and name the left-out physics",
      &hrg::audit::audit_main},
@@ -24,6 +25,8 @@ constexpr std::array<Command, 6> kCommands{{
     {"can-decode", "turn a candump log of the CAN telemetry into an hrg-recording v1",
      &hrg::can::can_decode_main},
     {"scenario-check", "validate simulator scenario files (TOML)", &scenario_check_main},
+    {"calibration-check", "validate a calibration file (TOML); write it as a C++ constant",
+     &calibration_check_main},
 }};
 }  // namespace
 

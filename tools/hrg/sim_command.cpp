@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "firmware/calibration_file.hpp"
 #include "sim_tools/console.hpp"
 #include "sim_tools/job.hpp"
 #include "sim_tools/profile_report.hpp"
@@ -24,7 +25,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
     "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
-    "               [--no-control-drift] [--profile] [--quiet]\n\n"
+    "               [--no-control-drift] [--calibration FILE] [--profile] [--quiet]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -44,6 +45,9 @@ constexpr const char* kUsage =
     "(the resonator model is still applied), for comparison.\n"
     "--profile prints where the host time goes: per firmware task and per stage\n"
     "of the simulated target (drives, resonator, noise, ADC).\n"
+    "--calibration FILE puts a calibration (hrg audit --calibration) in force:\n"
+    "the pickoff-map inverse and the drive-feedthrough removal on the chain's\n"
+    "demodulated quadratures.\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
 
 bool parse_double(std::string_view s, double& out) {
@@ -59,7 +63,7 @@ std::filesystem::path plots_script() {
 }
 
 struct SimOptions {
-  std::string scenario, out_dir = "sim-out", can_log;
+  std::string scenario, out_dir = "sim-out", can_log, calibration;
   double duration_s = 0.0;
   int bias_angles = 0;  // not given: the schedule's default
   bool plots = true, quiet = false, real_time = false, static_base = false, profile = false;
@@ -81,6 +85,10 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
     if (a == "--help" || a == "-h") {
       std::fputs(kUsage, stdout);
       return 0;
+    } else if (a == "--calibration") {
+      const char* v = value("--calibration");
+      if (v == nullptr) return 2;
+      o.calibration = v;
     } else if (a == "--scenario" || a == "--out" || a == "--can-log") {
       const char* v = value(args[i]);
       if (!v) return 2;
@@ -126,6 +134,8 @@ simtools::JobConfig make_job(const SimOptions& o) {
   simtools::JobConfig job =
       simtools::make_job(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
   job.firmware.gyro.compensate_control_drift = o.control_drift;
+  if (!o.calibration.empty())
+    job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
   return job;
 }
 

@@ -32,6 +32,7 @@
 #include <span>
 
 #include "dsp/demodulator.hpp"
+#include "dsp/electronics_correction.hpp"
 #include "dsp/fixed.hpp"
 #include "dsp/loops.hpp"
 #include "dsp/nco.hpp"
@@ -175,6 +176,17 @@ class Chain {
   // configuration. Base-frame task context.
   bool process(std::span<const q31_t> adc, std::span<q31_t> dac);
 
+  // Electronics correction (pickoff-map inverse, drive feedthrough) on the
+  // demodulated quadratures before the wave variables; false (nothing
+  // changed) when a coefficient does not fit the chain's number format.
+  bool set_electronics_correction(const PickoffCorrection<double>& pickoff,
+                                  const FeedthroughCoefficients<double>& feedthrough_v_per_v) {
+    return correction_.configure(pickoff, feedthrough_v_per_v, cfg_.adc_full_scale_v,
+                                 cfg_.dac_full_scale_v);
+  }
+  void clear_electronics_correction() { correction_.clear(); }
+  const ElectronicsCorrection<T>& electronics_correction() const { return correction_; }
+
   const ChainOutputs& outputs() const { return out_; }
   const ChainConfig& config() const { return cfg_; }
   uint32_t nco_phase() const { return phase_; }
@@ -188,6 +200,7 @@ class Chain {
   ChainConfig cfg_;
   bool usable_ = false;
   Demodulator<T> demod_;
+  ElectronicsCorrection<T> correction_;
   Pll pll_;
   LockDetector lock_;
   Agc agc_;
@@ -211,6 +224,9 @@ class Chain {
   double u_q_v_ = 0.0;
   double u_r_v_ = 0.0;
   double v0_v_ = 0.0;
+  // Pump envelope written for the next ADC block (volts, against the NCO).
+  double pump_env_re_v_ = 0.0;
+  double pump_env_im_v_ = 0.0;
 };
 
 extern template class Chain<q31_t>;

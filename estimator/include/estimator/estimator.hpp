@@ -58,7 +58,9 @@ class Estimator {
     control_.restart();
   }
   // Folds the window into the normal equations; Status::too_short etc. drop it.
-  Status end_window();
+  // With `fold` false the window is only checked against the model in force
+  // (a check window: the model it tests stays what it was).
+  Status end_window(bool fold = true);
   // Solves the configured variant; the model used for compensation changes
   // only if the solution is accepted (conditioning below the threshold).
   Solution solve_and_accept();
@@ -84,6 +86,14 @@ class Estimator {
   }
 
   bool has_model() const { return comp_.has_model(); }
+  // The model check on each window folded while a model is in force: the
+  // window's own residual sum of squares against the accepted model, per
+  // degree of freedom, over the accepted fit's residual variance (1 when
+  // the model holds for this window as for the windows it was fitted on;
+  // a window at another turn rate or temperature shows what the fit absorbed).
+  // 0 until a window has been checked.
+  double last_window_misfit() const { return last_misfit_; }
+  uint32_t windows_checked() const { return windows_checked_; }
   const ParamVector& model() const { return comp_.model(); }
   const Solution& last_solution() const { return last_; }
   double correction_rad() const { return comp_.correction_rad(); }
@@ -108,8 +118,11 @@ class Estimator {
   DriftCompensator comp_;
   ControlDriftEstimator control_;
   PumpDriftEstimator pump_;
+  void check_window(const WindowContribution& w);
   WindowContribution scratch_{};
   Solution last_{};
+  double last_misfit_ = 0.0;
+  uint32_t windows_checked_ = 0;
 };
 
 }  // namespace hrg::est

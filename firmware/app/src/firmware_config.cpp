@@ -35,6 +35,9 @@ FirmwareConfig default_firmware_config(const ConverterLayout& conv, WindowPlan p
   w.condition_good = 50.0;
   w.coverage_good = 1.0;
   apply_window_plan(w, plan);
+  // After the campaign, a check window every 20 s tests the model in force
+  // (the compensation is applied only while they agree with it).
+  w.check_period_frames = 20000;
   // The pump's gap part of D_Phi is used only once the pattern angles seen
   // with the excitation on make its 3x3 fit well conditioned: an early fit
   // from a few nearby angles adds more than it removes (default run: ADB

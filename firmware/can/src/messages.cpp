@@ -45,6 +45,7 @@ constexpr SignalDef kStatus[] = {
   {"exc_line", 9, 1, false, 1, 0, 0, 1, ""},
   {"fault_input", 10, 1, false, 1, 0, 0, 1, ""},
   {"ident_active", 11, 1, false, 1, 0, 0, 1, ""},
+  {"comp_valid", 12, 1, false, 1, 0, 0, 1, ""},
   {"faults", 16, 16, false, 1, 0, 0, 65535, ""},
   {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
   {"seq", 48, 8, false, 1, 0, 0, 255, ""},
@@ -123,6 +124,35 @@ constexpr SignalDef kReplySignals[] = {
   {"detail", 16, 8, false, 1, 0, 0, 255, ""},
   {"seq", 24, 8, false, 1, 0, 0, 255, ""},
 };
+// Calibration service: control frames end with the commands' CRC-8; data
+// frames carry a sequence number and 7 bytes of the block (little-endian).
+constexpr SignalDef kCalSeedRequest[] = {
+  {"crc", 0, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kCalKey[] = {
+  {"key", 0, 32, false, 1, 0, 0, 4294967295.0, ""},
+  {"crc", 32, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kCalStart[] = {
+  {"length", 0, 16, false, 1, 0, 0, 65535, "B"},
+  {"block_crc", 16, 32, false, 1, 0, 0, 4294967295.0, ""},
+  {"crc", 48, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kCalData[] = {
+  {"seq", 0, 8, false, 1, 0, 0, 255, ""},
+  {"data_lo", 8, 32, false, 1, 0, 0, 4294967295.0, ""},
+  {"data_hi", 40, 24, false, 1, 0, 0, 16777215, ""},
+};
+constexpr SignalDef kCalEnd[] = {
+  {"crc", 0, 8, false, 1, 0, 0, 255, ""},
+};
+constexpr SignalDef kCalReply[] = {
+  {"step", 0, 4, false, 1, 0, 0, 15, ""},
+  {"result", 4, 4, false, 1, 0, 0, 15, ""},
+  {"detail", 8, 8, false, 1, 0, 0, 255, ""},
+  {"value", 16, 32, false, 1, 0, 0, 4294967295.0, ""},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
 // clang-format on
 
 constexpr bool fits(std::span<const SignalDef> sigs, uint8_t dlc) {
@@ -159,6 +189,15 @@ const std::array<MessageDef, kCommandCount> kCommands = {{
 }};
 
 const MessageDef kReply = {"HRG_CMD_REPLY", kReplyId, 4, 0, "HRG", kReplySignals};
+
+const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages = {{
+  {"HOST_CAL_SEED_REQUEST", 0x0A0, 1, 0, "HOST", kCalSeedRequest},
+  {"HOST_CAL_KEY",          0x0A1, 5, 0, "HOST", kCalKey},
+  {"HOST_CAL_START",        0x0A2, 7, 0, "HOST", kCalStart},
+  {"HOST_CAL_DATA",         0x0A3, 8, 0, "HOST", kCalData},
+  {"HOST_CAL_END",          0x0A4, 1, 0, "HOST", kCalEnd},
+  {"HRG_CAL_REPLY",         0x0A8, 7, 0, "HRG",  kCalReply},
+}};
 // clang-format on
 
 static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoops, 8) &&
@@ -166,6 +205,8 @@ static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoo
               fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8));
 static_assert(fits(kSetMode, 3) && fits(kIdent, 3) && fits(kWindow, 6) && fits(kAgc, 4) &&
               fits(kStatusRequest, 2) && fits(kReplySignals, 4));
+static_assert(fits(kCalSeedRequest, 1) && fits(kCalKey, 5) && fits(kCalStart, 7) &&
+              fits(kCalData, 8) && fits(kCalEnd, 1) && fits(kCalReply, 7));
 
 namespace {
 bool same(const char* a, const char* b) {
@@ -183,6 +224,8 @@ const MessageDef* find_message(uint32_t id) {
   for (const auto& m : kCommands)
     if (m.id == id) return &m;
   if (id == kReply.id) return &kReply;
+  for (const auto& m : kCalibrationMessages)
+    if (m.id == id) return &m;
   return nullptr;
 }
 

@@ -78,6 +78,7 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::exc_line, b(s.exc_line), f);
       put(m, sig::fault_input, b(s.fault_input), f);
       put(m, sig::ident_active, b(s.ident_active), f);
+      put(m, sig::comp_valid, b(s.comp_valid), f);
       put(m, sig::faults, s.faults, f);
       put(m, sig::temp_c, s.temp_c, f);
       break;

@@ -59,6 +59,13 @@ class DspChainPort final : public SignalChain {
   const char* error() const { return error_; }
   const char* config_error() const override { return error_; }
   const dsp::Chain<Sample>& chain() const { return chain_; }
+  // The electronics correction on the demodulated quadratures (see
+  // dsp::Chain::set_electronics_correction); false leaves it unchanged.
+  bool set_electronics_correction(const dsp::PickoffCorrection<double>& pickoff,
+                                  const dsp::FeedthroughCoefficients<double>& feedthrough_v_per_v) {
+    return chain_.set_electronics_correction(pickoff, feedthrough_v_per_v);
+  }
+  void clear_electronics_correction() { chain_.clear_electronics_correction(); }
   double pattern_max_rate_rad_s() const { return pattern_max_rate_rad_s_; }
 
  private:

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstdint>
+
 namespace hrg::fw {
 
 // What the estimator reports about its own state (the window scheduler ends
@@ -9,6 +11,11 @@ struct EstimatorHealth {
   bool solved = false;     // a solution exists
   double condition = 0.0;  // condition number of H^T H (max/min eigenvalue)
   double coverage = 0.0;   // share of 4 theta bins with data, 0..1
+  // The model check: the last window's residual against the model in force,
+  // over the fit's own residual (1: the model holds), and how many windows
+  // were checked so far.
+  double window_misfit = 0.0;
+  uint32_t windows_checked = 0;
 };
 
 }  // namespace hrg::fw

@@ -16,6 +16,7 @@ class EstimatorPort final : public ResonatorIdentifier {
   void begin_window(double t_s) override;
   void add_sample(const ChainRecord& s) override;
   void end_window() override;
+  void end_check_window() override;
   void abort_window() override;
   void solve() override;
   EstimatorHealth health() const override { return health_; }

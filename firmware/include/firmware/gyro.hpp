@@ -30,6 +30,11 @@ struct GyroConfig {
   bool compensate_drift = true;          // add the drift model (after the window campaign)
   bool compensate_control_drift = true;  // and D_Phi with the excitation on (needs the model)
   bool identify = true;                  // run the windows (off: use the model it has)
+  // Do no harm: the model applied at the end of the campaign is withdrawn
+  // for good as soon as a check window disagrees with it (misfit,
+  // EstimatorHealth::window_misfit, above this): the output is then the raw
+  // angle, reported so.
+  double max_window_misfit = 4.0;
   WindowConfig windows{};
   MonitorConfig monitor{};
 };
@@ -50,6 +55,13 @@ struct GyroStatus {
   double drift_rad_s = 0.0;          // D used for the correction (Omega K units)
   double control_drift_rad_s = 0.0;  // its control-loop part D_Phi
   bool out_valid = false;
+  // The drift compensation is in force: the campaign has ended and no check
+  // window has disagreed with its model (false for good after one did).
+  bool compensation_applied = false;
+  // ... and a check window has agreed with it: the compensated output is
+  // one the firmware stands behind.
+  bool compensation_valid = false;
+  uint32_t model_checks_failed = 0;
   uint32_t adc_errors = 0;
   uint32_t adc_missed_blocks = 0;
   uint32_t dac_errors = 0;
@@ -122,6 +134,8 @@ class Gyro {
 
  private:
   void on_mode_change(Mode from, Mode to);
+  // Do no harm: updates status_.compensation_valid from the check windows.
+  void check_model();
   bool in_bands() const;
   void step_mode_progress(const WindowDecision& d);
   void apply(const can::Command& c);
@@ -152,6 +166,8 @@ class Gyro {
   uint32_t pattern_hold_frames_ = 0;
   bool host_pattern_ = false;
   bool compensation_ready_ = false;
+  uint32_t checks_seen_ = 0;
+  uint32_t checks_passed_ = 0;
   double host_pattern_target_rad_ = 0.0;
   bool enable_written_ = false;
   bool board_ok_ = true;

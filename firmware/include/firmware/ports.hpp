@@ -58,6 +58,8 @@ class ResonatorIdentifier {
   virtual void begin_window(double t_s) = 0;
   virtual void add_sample(const ChainRecord& s) = 0;
   virtual void end_window() = 0;
+  // A check window: tested against the model in force, not folded into it.
+  virtual void end_check_window() { end_window(); }
   virtual void abort_window() = 0;
   // Slow task: refresh the solution from the accumulated normal equations.
   virtual void solve() = 0;

@@ -24,6 +24,7 @@ struct WindowConfig {
   bool rotate_on_static_base = true;   // command the pattern angle to fill empty bins
   double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
+  uint32_t check_period_frames = 0;    // after the campaign, a check window this often (0: none)
 };
 
 struct WindowDecision {
@@ -69,6 +70,7 @@ class WindowScheduler {
 
  private:
   bool under_covered(uint32_t bin) const;
+  void open(uint32_t bin, WindowDecision& d);
   uint32_t least_covered_bin() const;
 
   WindowConfig cfg_;
@@ -82,7 +84,9 @@ class WindowScheduler {
   uint32_t windows_ = 0;
   bool in_window_ = false;
   bool done_ = false;
-  bool moving_ = false;  // a commanded pattern move is under way
+  bool static_checked_ = false;  // a check window has run on a still base
+  uint32_t static_frames_ = 0;   // frames the base has been still, after the campaign
+  bool moving_ = false;          // a commanded pattern move is under way
   double move_target_rad_ = 0.0;
 };
 

@@ -350,6 +350,7 @@ State Auditor::weight_forced_segments(const Mask& base, State cur) {
 
 void Auditor::describe_data(AuditResult& out) const {
   out.noise_v = d_.noise_v;
+  out.temp_ref_c = d_.temp_ref_c;
   out.free_segments = static_cast<int>(d_.free.size());
   out.forced_segments = static_cast<int>(d_.forced.size());
   out.blocks = static_cast<int>(d_.blocks.size());
@@ -619,6 +620,8 @@ void Auditor::claim_findings(const State& cur, const std::vector<Chosen>& chosen
     f.sigma = c.sigma;
     f.significance = c.sigma > 0.0 ? std::abs(c.value) / c.sigma : 0.0;
     f.explains_fraction = c.fraction;
+    if (c.effect == Effect::drive_feedthrough)
+      f.feedthrough_re_im = feedthrough_stat(d_, cur.fit.p, ln_neff(cur)).c_re_im;
     f.heldout_rms_before_v = out.heldout_rms_v;
     f.heldout_rms_after_v = out.heldout_rms_final_v;
     f.impact = impact_text(d_, cur.fit.p, c.effect, f.value);

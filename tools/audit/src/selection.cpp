@@ -260,6 +260,7 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
     best_c = free_c;
     fs.sigma = best_sigma;
   }
+  fs.c_re_im = {best_c(0), best_c(1), best_c(2), best_c(3)};
   fs.c_x = std::hypot(best_c(0), best_c(1));
   fs.c_y = std::hypot(best_c(2), best_c(3));
   return fs;

@@ -16,9 +16,10 @@ namespace hrg::audit::detail {
 struct FeedStat {
   bool testable = false;
   double dchi2 = 0.0;  // against no feedthrough, chi^2 with 4 degrees of freedom under null
-  double c_x = 0.0, c_y = 0.0;  // |c_k| (V/V)
-  double sigma = 0.0;           // of the larger |c_k|
-  double threshold = 0.0;       // |c| at which the expected delta BIC is zero
+  double c_x = 0.0, c_y = 0.0;      // |c_k| (V/V)
+  std::array<double, 4> c_re_im{};  // re/im c_x, re/im c_y (V/V)
+  double sigma = 0.0;               // of the larger |c_k|
+  double threshold = 0.0;           // |c| at which the expected delta BIC is zero
   int edges = 0;
   int dropped = 0;  // switch-offs left out as control transients
 };

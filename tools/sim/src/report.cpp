@@ -58,6 +58,12 @@ bool judge(const JobConfig& job, JobResult& r) {
                                r.comp_error_end_deg, r.drift_bound_deg));
     }
   }
+  if (r.model_checks_failed > 0) {
+    r.failures.push_back(
+        fmt("the drift compensation is not valid: %u check window(s) disagreed "
+            "with the model (last misfit %.1f); the output is the raw angle",
+            r.model_checks_failed, r.last_window_misfit));
+  }
   if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
       r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
     r.failures.push_back(
@@ -186,6 +192,15 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
     w.string({}, f);
   w.end_array();
   drift_json(w, r);
+  w.begin_object("compensation");
+  w.boolean("valid", r.compensation_valid);
+  w.boolean("applied", r.compensation_applied);
+  w.integer("model_checks_failed", r.model_checks_failed);
+  w.number("last_window_misfit", r.last_window_misfit);
+  // The calibration in force (CRC-32 of its canonical form, as hrg
+  // calibration-check prints it; that of the identity when none was given).
+  w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
+  w.end_object();
   identification_json(w, r);
   tracking_json(w, r);
   executive_json(w, r);
@@ -223,6 +238,7 @@ const std::vector<std::string>& telemetry_columns() {
                                              "drift_true_dph",
                                              "out_valid",
                                              "pattern_cmd",
+                                             "comp_valid",
                                              "raw_error_deg",
                                              "out_error_deg"};
   return cols;
@@ -253,6 +269,7 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
        row.drift_true_dph,
        double(row.out_valid),
        double(row.pattern_cmd),
+       double(row.comp_valid),
        row.raw_error_deg,
        row.out_error_deg};
 }

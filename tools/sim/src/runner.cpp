@@ -240,6 +240,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const Row
       true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) / k * kRadSToDph;
   row.out_valid = st.out_valid ? 1 : 0;
   row.pattern_cmd = st.pattern_control ? 1 : 0;
+  row.comp_valid = st.compensation_valid ? 1 : 0;
   r.rows.push_back(row);
 }
 
@@ -353,6 +354,10 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(),
                   static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
   r.final_mode = gyro.status().mode;
+  r.compensation_valid = gyro.status().compensation_valid;
+  r.compensation_applied = gyro.status().compensation_applied;
+  r.model_checks_failed = gyro.status().model_checks_failed;
+  r.last_window_misfit = firmware->estimator().health().window_misfit;
   r.can_bus_off_events = target.can().counters().bus_off_events;
   r.can_restarts = gyro.can_restarts();
   summarise_identification(r, job, *firmware);

@@ -82,6 +82,9 @@ struct Finding {
   double explains_fraction = 0.0;
   double significance = 0.0;  // |value| / sigma
   std::string impact;         // in gyro units
+  // drive_feedthrough only: c_x and c_y as re/im pairs (V/V) against the wave
+  // phase at the edge (the recording carries the pump amplitude, not its phase).
+  std::array<double, 4> feedthrough_re_im{};
 };
 
 // One term of the generic description of structure no catalogue effect names.
@@ -140,6 +143,7 @@ struct AuditResult {
   double fit_rms_before_v = 0.0;     // baseline, all free-decay samples
   double fit_rms_after_v = 0.0;      // selected model
   double noise_v = 0.0;              // white-noise level from second differences
+  double temp_ref_c = 0.0;           // T0 of the thermal effects (mid-range of temp_c)
   double n_effective = 0.0;
   std::vector<Location> locations;
   std::vector<Finding> findings;

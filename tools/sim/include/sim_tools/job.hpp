@@ -80,6 +80,7 @@ struct TelemetryRow {
   double drift_control_dph;  // the control-loop part of drift_model_dph
   int out_valid;
   int pattern_cmd;  // the pattern is being moved on purpose
+  int comp_valid;   // the drift compensation is in force (its model checks agree)
   // Output minus truth, accumulated only between consecutive rows with a
   // valid output (a held output while the pattern is moved on purpose does
   // not count as an error), deg.
@@ -133,6 +134,12 @@ struct JobResult {
   double noise_sigma_v = 0.0;
   double t_converged_s = -1.0;          // the window campaign ended (model applied)
   double control_drift_mean_dph = 0.0;  // mean D_Phi/K added over the valid output
+  // Do no harm: the compensation in force at the end (its model checks
+  // agreed), the failed checks, the last check window's misfit.
+  bool compensation_valid = false;
+  bool compensation_applied = false;
+  uint32_t model_checks_failed = 0;
+  double last_window_misfit = 0.0;
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;

@@ -23,7 +23,9 @@ class Firmware {
       : cfg_(cfg),
         chain_(cfg.chain),
         estimator_(cfg.estimator),
-        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {}
+        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {
+    calibration_ok_ = apply_calibration(cfg.calibration);
+  }
   Firmware(const Firmware&) = delete;
   Firmware& operator=(const Firmware&) = delete;
 
@@ -32,9 +34,17 @@ class Firmware {
   // do not match the firmware's block layout).
   const char* error() const {
     if (const char* e = chain_.error()) return e;
+    if (!calibration_ok_) return "the calibration is out of range or does not fit the chain";
     return gyro_.board_ok() ? nullptr
                             : "the board's converters do not match the firmware's block layout";
   }
+
+  // Puts `cal` in force: the pickoff-map inverse and the feedthrough removal
+  // on the chain's demodulated quadratures. All or nothing: false (the one in
+  // force stays) when a field is out of range or a coefficient does not fit
+  // the chain's Q formats.
+  bool apply_calibration(const Calibration& cal);
+  const Calibration& calibration() const { return cfg_.calibration; }
 
   void run_frame() { gyro_.run_frame(); }
   Gyro& gyro() { return gyro_; }
@@ -48,6 +58,7 @@ class Firmware {
   DspChainPort chain_;
   EstimatorPort estimator_;
   Gyro gyro_;
+  bool calibration_ok_ = true;
 };
 
 }  // namespace hrg::fw::app

@@ -3,6 +3,7 @@
 
 #include "dsp/chain.hpp"
 #include "estimator/estimator.hpp"
+#include "firmware/calibration.hpp"
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/gyro.hpp"
 
@@ -17,6 +18,9 @@ struct FirmwareConfig {
   GyroConfig gyro;
   dsp::ChainConfig chain;
   est::Estimator::Config estimator;
+  // What the firmware corrects of this gyro's electronics (the identity by
+  // default; a file, a CAN block or the built-in constant on bare metal).
+  Calibration calibration = kIdentityCalibration;
 };
 
 // How the free-decay windows identify the resonator.

@@ -47,9 +47,14 @@ inline constexpr uint32_t kCommandIdLast =
     0x08F;  // the whole range is ours: unknown ids get a reply
 inline constexpr uint32_t kReplyId = 0x090;
 
+// Calibration service (calibration_transfer.hpp): host frames 0x0A0-0x0A4
+// (seed request, key, start, data, end) and the reply 0x0A8, in that order.
+inline constexpr std::size_t kCalibrationMessageCount = 6;
+
 extern const std::array<MessageDef, kTelemetryCount> kTelemetry;
 extern const std::array<MessageDef, kCommandCount> kCommands;
 extern const MessageDef kReply;
+extern const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages;
 
 constexpr const MessageDef& telemetry_def(Tm m) { return kTelemetry[static_cast<std::size_t>(m)]; }
 
@@ -71,6 +76,7 @@ enum Status : uint8_t {
   exc_line,
   fault_input,
   ident_active,
+  comp_valid,
   faults,
   temp_c,
   status_seq

@@ -31,6 +31,7 @@ struct TelemetrySnapshot {
   bool exc_line = false;      // excitation enable line as driven
   bool fault_input = false;   // board fault input
   bool ident_active = false;  // identification (window schedule) running
+  bool comp_valid = false;    // the drift compensation is in force and its model checks agree
   uint16_t faults = 0;        // Fault bits
   double temp_c = 0;
   // Identification: p = (nu, dnu_C, dnu_S, dw_C, dw_S) of physics.md section 5.

@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: MIT
+#include "audit/calibration_writer.hpp"
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+
+namespace hrg::audit {
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// Index of a field of kCalibrationFields by its key.
+std::size_t field(const char* key) {
+  for (std::size_t i = 0; i < fw::kCalibrationFieldCount; ++i) {
+    if (std::string(fw::kCalibrationFields[i].key) == key) return i;
+  }
+  throw std::logic_error(std::string("no calibration field ") + key);
+}
+
+std::string fmt(const char* f, double a, double b = 0.0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, f, a, b);
+  return buf;
+}
+
+// Sets a field from a catalogue value and its sigma (scale: catalogue -> SI),
+// refusing a value outside the field's range.
+void set(fw::CalibrationFile& out, const char* key, double value, double sigma, double scale) {
+  const std::size_t i = field(key);
+  const fw::CalibrationField& f = fw::kCalibrationFields[i];
+  const double v = value * scale;
+  if (!(v >= f.min && v <= f.max)) {
+    throw fw::CalibrationFileError(std::string("audit finding for '") + key +
+                                   "' = " + fmt("%.6g", v) + " is outside the firmware's range; " +
+                                   "no calibration written");
+  }
+  out.calibration.*f.member = v;
+  out.sigma[i] = std::fabs(sigma * scale);
+}
+
+void set_feedthrough(fw::CalibrationFile& out, const Finding& f, double pump_phase_rad,
+                     std::vector<std::string>& comments) {
+  const std::complex<double> rot = std::polar(1.0, -pump_phase_rad);
+  const std::complex<double> cx =
+      std::complex<double>(f.feedthrough_re_im[0], f.feedthrough_re_im[1]) * rot;
+  const std::complex<double> cy =
+      std::complex<double>(f.feedthrough_re_im[2], f.feedthrough_re_im[3]) * rot;
+  set(out, "feedthrough_x_re_v_per_v", cx.real(), f.sigma, 1.0);
+  set(out, "feedthrough_x_im_v_per_v", cx.imag(), f.sigma, 1.0);
+  set(out, "feedthrough_y_re_v_per_v", cy.real(), f.sigma, 1.0);
+  set(out, "feedthrough_y_im_v_per_v", cy.imag(), f.sigma, 1.0);
+  comments.push_back(
+      fmt("drive_feedthrough: per volt of the pump envelope, taken %.1f deg ahead "
+          "of the wave (--pump-phase-deg); sigma is that of the larger |c|",
+          pump_phase_rad / kDegToRad));
+}
+
+void apply_finding(fw::CalibrationFile& out, const Finding& f, const AuditResult& r,
+                   const CalibrationWriterOptions& opt, std::vector<std::string>& comments) {
+  switch (f.effect) {
+    case Effect::pickoff_gain_mismatch: set(out, "pickoff_y_gain", f.value, f.sigma, 1.0); break;
+    case Effect::pickoff_phase_mismatch:
+      set(out, "pickoff_y_phase_rad", f.value, f.sigma, kDegToRad);
+      break;
+    case Effect::pickoff_misalignment:
+      set(out, "pickoff_y_misalignment_rad", f.value, f.sigma, kDegToRad);
+      break;
+    case Effect::duffing_stiffness: set(out, "duffing_hz_per_v2", f.value, f.sigma, 1.0); break;
+    case Effect::nonlinear_damping:
+      set(out, "nonlinear_damping_per_v2", f.value, f.sigma, 1.0);
+      break;
+    case Effect::thermal_frequency:
+    case Effect::thermal_damping:
+      set(out,
+          f.effect == Effect::thermal_frequency ? "thermal_frequency_ppm_per_c"
+                                                : "thermal_damping_per_c",
+          f.value, f.sigma, 1.0);
+      set(out, "temperature_ref_c", r.temp_ref_c, 0.0, 1.0);
+      break;
+    case Effect::electrostatic_spring:
+      set(out, "electrostatic_spring_hz_per_v2", f.value, f.sigma, 1.0);
+      break;
+    case Effect::drive_feedthrough: set_feedthrough(out, f, opt.pump_phase_rad, comments); break;
+  }
+}
+
+}  // namespace
+
+CalibrationFromAudit calibration_from_audit(const AuditResult& r, const std::string& source,
+                                            const CalibrationWriterOptions& opt) {
+  CalibrationFromAudit out;
+  auto& c = out.comments;
+  c.push_back("hrg calibration from `hrg audit " + source + "` (verdict: " + r.verdict + ")");
+  c.push_back("values are the audit's accepted findings; *_sigma is one standard deviation;");
+  c.push_back("a key left at 0 was not found (nothing is corrected for it)");
+  for (const Finding& f : r.findings)
+    apply_finding(out.file, f, r, opt, c);
+  for (const Alternative& a : r.alternatives) {
+    c.push_back(std::string("not applied: ") + effect_info(a.effect).id + " " +
+                fmt("%.4g", a.value) + " " + effect_info(a.effect).unit +
+                " (an alternative, not an accepted finding: " + a.note + ")");
+  }
+  if (r.verdict == "unexplained") {
+    c.push_back("not applied: structure the catalogue does not explain (" + r.unexplained_note +
+                "); the firmware has no correction for it");
+  }
+  if (r.verdict == "ambiguous" && !r.ambiguity_experiment.empty()) {
+    c.push_back("ambiguous: " + r.ambiguity_experiment);
+  }
+  c.push_back(
+      "not examined: ring-electrode gap harmonics (the seed's centring tolerance) are not in "
+      "the audit's model, so nothing here corrects them");
+  c.push_back(
+      "not in the file: the baseline (frequency, damping and its anisotropy, split, "
+      "angular gain) is what the estimator identifies online, not a calibration");
+  return out;
+}
+
+void write_calibration_file(const std::string& path, const AuditResult& r,
+                            const std::string& source, const CalibrationWriterOptions& opt) {
+  const CalibrationFromAudit c = calibration_from_audit(r, source, opt);
+  fw::save_calibration(path, c.file, c.comments, {});
+}
+
+}  // namespace hrg::audit

@@ -1,0 +1,187 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""The Gregory table: each catalogue effect at a real gyro's strength, through
+the whole loop, and what each stage of the compensation makes of it.
+
+Per row: run the default scenario with the effect on (hrg sim), audit that
+run's telemetry into a calibration file (hrg audit --calibration), run again
+with the file in force (hrg sim --calibration). Columns: raw ADB; ADB
+compensated by the seed's model alone; ADB after the audit round; the clean
+gyro's compensated ADB; the maximum pattern-angle readout error (firmware's
+theta_A against the true pattern angle) before and after; whether the first
+run reported its compensation valid.
+
+Goals (--check, exit 1 when one is missed): after the audit round every row
+<= 2x the clean compensated ADB (--goals full only) and >= 20x below raw;
+readout error after calibration <= 0.01 deg on the pickoff rows; without
+calibration, no row reports a valid compensated output worse than raw.
+
+usage: gregory_table.py --hrg PATH --scenario default.toml [--rows a,b] [--jobs N]
+                        [--work DIR] [--check] [--goals full|loop]
+"""
+import argparse
+import concurrent.futures as cf
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+
+# name -> ({section: {key: value}}, pickoff row?)
+ROWS = {
+    "none": ({}, False),
+    "pickoff_gain_mismatch": ({"effects.pickoff_gain_mismatch": {"enabled": "true", "gain": "0.01"}}, True),
+    "pickoff_misalignment": ({"effects.pickoff_misalignment": {"enabled": "true", "angle_deg": "0.5"}}, True),
+    "pickoff_phase_mismatch": ({"effects.pickoff_phase_mismatch": {"enabled": "true", "phase_deg": "1.0"}}, True),
+    "drive_feedthrough": ({"effects.drive_feedthrough": {
+        "enabled": "true", "x_v_per_v": "1e-3", "y_v_per_v": "5e-4",
+        "x_phase_deg": "30.0", "y_phase_deg": "30.0"}}, False),
+    "thermal_damping": ({"effects.thermal_damping": {"enabled": "true", "rel_per_c": "0.004"},
+                         "temperature": {"kind": '"sine"', "amplitude_c": "1.0", "freq_hz": "0.005",
+                                         "mean_c": "25.0", "value_c": None}}, False),
+    "thermal_frequency": ({"effects.thermal_frequency": {"enabled": "true", "ppm_per_c": "5.0"},
+                           "temperature": {"kind": '"sine"', "amplitude_c": "1.0", "freq_hz": "0.005",
+                                           "mean_c": "25.0", "value_c": None}}, False),
+    "duffing_stiffness": ({"effects.duffing_stiffness": {"enabled": "true", "hz_per_v2": "2e-3"}}, False),
+    "nonlinear_damping": ({"effects.nonlinear_damping": {"enabled": "true", "rel_per_v2": "0.05"}}, False),
+    "electrostatic_spring": ({"effects.electrostatic_spring": {"enabled": "true", "hz_per_v2": "-1.11e-4"}}, False),
+    "gap_harmonics": ({"electrodes": {"eps_p": "0.02", "eps_q": "0.01"}}, False),
+    "pickoff_combination": ({
+        "effects.pickoff_gain_mismatch": {"enabled": "true", "gain": "0.01"},
+        "effects.pickoff_misalignment": {"enabled": "true", "angle_deg": "0.3"},
+        "effects.pickoff_phase_mismatch": {"enabled": "true", "phase_deg": "0.5"}}, True),
+    "thermal_combination": ({
+        "effects.thermal_frequency": {"enabled": "true", "ppm_per_c": "5.0"},
+        "effects.thermal_damping": {"enabled": "true", "rel_per_c": "0.004"},
+        "temperature": {"kind": '"sine"', "amplitude_c": "2.0", "freq_hz": "0.005",
+                        "mean_c": "25.0", "value_c": None}}, False),
+}
+
+
+def set_key(text, section, key, value):
+    """Sets `key = value` inside [section] of a TOML text (added when absent)."""
+    lines = text.split("\n")
+    head = "[" + section + "]"
+    try:
+        start = next(i for i, l in enumerate(lines) if l.strip() == head)
+    except StopIteration:
+        raise SystemExit("scenario has no [%s]" % section)
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("[")), len(lines))
+    pat = re.compile(r"^\s*" + re.escape(key) + r"\s*=")
+    for i in range(start + 1, end):
+        if pat.match(lines[i]):
+            if value is None:
+                del lines[i]
+            else:
+                lines[i] = "%s = %s" % (key, value)
+            return "\n".join(lines)
+    if value is None:
+        return "\n".join(lines)
+    lines.insert(start + 1, "%s = %s" % (key, value))
+    return "\n".join(lines)
+
+
+def readout_error_deg(telemetry):
+    """Largest |theta_A - true pattern angle| (mod 90 deg) over the valid output."""
+    worst = 0.0
+    with open(telemetry) as f:
+        rows = csv.DictReader(l for l in f if not l.startswith("#"))
+        for r in rows:
+            if r["out_valid"] != "1" or float(r["a_a_v"]) < 0.5:
+                continue
+            d = float(r["theta_deg"]) - float(r["true_theta_deg"])
+            d = (d + 45.0) % 90.0 - 45.0
+            worst = max(worst, abs(d))
+    return worst
+
+
+def run_sim(hrg, scenario, out, calibration=None):
+    cmd = [hrg, "sim", "--scenario", scenario, "--out", out, "--no-plots", "--quiet"]
+    if calibration:
+        cmd += ["--calibration", calibration]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode == 2:
+        raise SystemExit("hrg sim failed: %s\n%s" % (" ".join(cmd), p.stderr))
+    rep = json.load(open(os.path.join(out, "report.json")))
+    d = rep["drift"]
+    comp = rep.get("compensation", {})
+    return {"raw": d["raw"]["adb_dph"], "comp": d["compensated"]["adb_dph"],
+            "passed": rep["passed"], "valid": comp.get("valid", True),
+            "readout": readout_error_deg(os.path.join(out, "telemetry.csv"))}
+
+
+def run_row(hrg, base, work, name):
+    edits, _ = ROWS[name]
+    text = open(base).read()
+    for section, kv in edits.items():
+        for k, v in kv.items():
+            text = set_key(text, section, k, v)
+    d = os.path.join(work, name)
+    os.makedirs(d, exist_ok=True)
+    scen = os.path.join(d, "scenario.toml")
+    open(scen, "w").write(text)
+    before = run_sim(hrg, scen, os.path.join(d, "run0"))
+    cal = os.path.join(d, "cal.toml")
+    p = subprocess.run([hrg, "audit", os.path.join(d, "run0", "telemetry.csv"), "--calibration", cal],
+                       capture_output=True, text=True)
+    if not os.path.exists(cal):
+        raise SystemExit("hrg audit wrote no calibration for %s:\n%s%s" % (name, p.stdout, p.stderr))
+    verdict = next((l.split()[1] for l in p.stdout.splitlines() if l.startswith("VERDICT:")), "?")
+    after = run_sim(hrg, scen, os.path.join(d, "run1"), cal)
+    return name, before, after, verdict
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--hrg", required=True)
+    ap.add_argument("--scenario", required=True)
+    ap.add_argument("--rows", default=",".join(ROWS))
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--work", default="gregory-work")
+    ap.add_argument("--check", action="store_true")
+    ap.add_argument("--goals", choices=["full", "loop"], default="full")
+    a = ap.parse_args()
+    names = a.rows.split(",")
+    for n in names:
+        if n not in ROWS:
+            raise SystemExit("unknown row '%s' (rows: %s)" % (n, ", ".join(ROWS)))
+    if "none" not in names:
+        names = ["none"] + names
+    with cf.ThreadPoolExecutor(a.jobs) as ex:
+        res = {r[0]: r[1:] for r in ex.map(lambda n: run_row(a.hrg, a.scenario, a.work, n), names)}
+    clean = res["none"][0]["comp"]
+    print("| effect | raw | seed model | (valid) | after audit round | (valid) | clean | readout before | after | audit verdict | goals |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    missed = []
+    for n in names:
+        b, c, verdict = res[n]
+        goals = []
+        if n != "none":
+            if a.goals == "full" and not c["comp"] <= 2.0 * clean:
+                goals.append("after %.3g > 2x clean %.3g" % (c["comp"], 2.0 * clean))
+            if not c["comp"] * 20.0 <= b["raw"]:
+                goals.append("after not 20x below raw")
+            if not c["valid"]:
+                goals.append("after: compensation not valid")
+            if ROWS[n][1] and not c["readout"] <= 0.01:
+                goals.append("readout %.3g deg > 0.01" % c["readout"])
+        for run in (b, c):
+            if run["valid"] and run["comp"] > run["raw"]:
+                goals.append("valid compensation worse than raw")
+        print("| %s | %.3g | %.3g | %s | %.3g | %s | %.3g | %.3g | %.3g | %s | %s |" % (
+            n, b["raw"], b["comp"], "yes" if b["valid"] else "NO", c["comp"],
+            "yes" if c["valid"] else "NO", clean,
+            b["readout"], c["readout"], verdict, "; ".join(goals) if goals else "met"))
+        if goals:
+            missed.append(n)
+    print("ADB in deg/h of input rate; readout error in deg (max |theta_A - true|).")
+    if a.check and missed:
+        print("goals missed: " + ", ".join(missed))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
