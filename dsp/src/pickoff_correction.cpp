@@ -107,11 +107,14 @@ bool feedthrough_to_q31(const FeedthroughCoefficients<double>& k_v_per_v, double
 }
 
 PumpEnvelopeFilter::PumpEnvelopeFilter(uint32_t block_frames) {
-  const double l = block_frames > 0 ? static_cast<double>(block_frames) : 1.0;
-  const double l2 = 6.0 * l * l;
-  w_[0] = (l + 1.0) * (l + 2.0) / l2;
-  w_[2] = (l - 1.0) * (l - 2.0) / l2;
-  w_[1] = 1.0 - w_[0] - w_[2];
+  const int64_t l = block_frames > 0 ? static_cast<int64_t>(block_frames) : 1;
+  const double norm = std::pow(static_cast<double>(l), static_cast<double>(kDecimatorOrder));
+  for (uint32_t k = 0; k < kDecimatorOrder; ++k) {
+    double sum = 0.0;
+    for (int64_t r = 0; r < l; ++r)
+      sum += static_cast<double>(DecimatorWeights::bspline(static_cast<int64_t>(k) * l + r, l));
+    w_[k] = sum / norm;
+  }
 }
 
 void PumpEnvelopeFilter::reset() {
@@ -120,10 +123,18 @@ void PumpEnvelopeFilter::reset() {
 }
 
 void PumpEnvelopeFilter::push(double pump_re, double pump_im, double& out_re, double& out_im) {
-  out_re = w_[0] * pump_re + w_[1] * re_[0] + w_[2] * re_[1];
-  out_im = w_[0] * pump_im + w_[1] * im_[0] + w_[2] * im_[1];
-  re_ = {pump_re, re_[0]};
-  im_ = {pump_im, im_[0]};
+  out_re = w_[0] * pump_re;
+  out_im = w_[0] * pump_im;
+  for (std::size_t k = 1; k < w_.size(); ++k) {
+    out_re += w_[k] * re_[k - 1];
+    out_im += w_[k] * im_[k - 1];
+  }
+  for (std::size_t i = re_.size() - 1; i > 0; --i) {
+    re_[i] = re_[i - 1];
+    im_[i] = im_[i - 1];
+  }
+  re_[0] = pump_re;
+  im_[0] = pump_im;
 }
 
 }  // namespace hrg::dsp

@@ -260,7 +260,7 @@ TEST(PickoffCorrection, PumpEnvelopeFilterFollowsTheDemodulatorAcrossSwitching) 
   // Feedthrough alone at the NCO frequency, the pump envelope constant per
   // block and switched on, turned in phase, and off. The demodulator's
   // baseband output is k times the filtered envelope exactly; what remains at
-  // a switching block is the 2f mixing product, which the sinc^3 nulls only
+  // a switching block is the 2f mixing product, which the sinc^5 nulls only
   // for a steady envelope (its per-block weights are not flat). Subtracting
   // k P of the current block alone would leave most of each step.
   constexpr uint32_t kL = 100;
@@ -268,14 +268,18 @@ TEST(PickoffCorrection, PumpEnvelopeFilterFollowsTheDemodulatorAcrossSwitching) 
   Demodulator<double> demod(kL);
   PumpEnvelopeFilter filter(kL);
   const auto w = filter.weights();
-  DOUBLES_EQUAL(1.0, w[0] + w[1] + w[2], 1e-15);
-  DOUBLES_EQUAL(102.0 * 101.0 / 60000.0, w[0], 1e-15);
+  double w_sum = 0.0;
+  for (const double wk : w)
+    w_sum += wk;
+  DOUBLES_EQUAL(1.0, w_sum, 1e-14);
+  // w0 = C(L + 4, 5) / L^5 for the sinc^5 decimator.
+  DOUBLES_EQUAL(104.0 * 103.0 * 102.0 * 101.0 / 120e8, w[0], 1e-15);
   const cplx k = std::polar(0.4, 0.7);
   uint32_t phase = 0;
   double steady = 0.0;
   double switching = 0.0;
   double naive = 0.0;
-  cplx prev[2] = {};
+  cplx prev[kDecimatorOrder - 1] = {};
   for (int n = 0; n < 16; ++n) {
     const cplx p = (n >= 3 && n < 9) ? std::polar(1.0, n >= 6 ? 2.0 : -0.5) : cplx{};
     q31_t frames[2 * kL];
@@ -293,10 +297,13 @@ TEST(PickoffCorrection, PumpEnvelopeFilterFollowsTheDemodulatorAcrossSwitching) 
     filter.push(p.real(), p.imag(), re, im);
     const cplx got(out.cx, -out.sx);  // X = cx - i sx
     const double err = std::abs(got - k * cplx(re, im)) / std::abs(k);
-    const bool steady_block = p == prev[0] && p == prev[1];
+    bool steady_block = true;
+    for (const cplx& q : prev)
+      steady_block = steady_block && q == p;
     (steady_block ? steady : switching) = std::max(steady_block ? steady : switching, err);
     if (!steady_block) naive = std::max(naive, std::abs(got - k * p) / std::abs(k));
-    prev[1] = prev[0];
+    for (std::size_t i = kDecimatorOrder - 2; i > 0; --i)
+      prev[i] = prev[i - 1];
     prev[0] = p;
   }
   std::printf(

@@ -129,12 +129,12 @@ bool feedthrough_to_q31(const FeedthroughCoefficients<double>& k_v_per_v, double
 // each block over three outputs; for an envelope held constant over each
 // block (the chain synthesises the pump at the NCO phase plus a per-block
 // offset) the output at the end of block n is exactly
-//     w0 P_n + w1 P_{n-1} + w2 P_{n-2},
-// w0 = (L+1)(L+2) / (6 L^2), w2 = (L-1)(L-2) / (6 L^2), w1 = 1 - w0 - w2
-// (the sums of the cascade's integer weights over each block, over L^3).
+//     w0 P_n + w1 P_{n-1} + ... + w_{N-1} P_{n-N+1}   (N = kDecimatorOrder),
+// w_k the sum of the cascade's integer weights over block n - k, over L^N
+// (w0 = C(L+N-1, N) / L^N).
 // Feeding it the envelope actually acting during each ADC block (zero while
 // the pump is off) makes the removal right at the switching instants too,
-// up to the 2f mixing product of the step, which the sinc^3 nulls only for
+// up to the 2f mixing product of the step, which the sinc^N nulls only for
 // a steady envelope (1.6 % of the step in the test at the default block,
 // for one block). In the chain the DAC block written after ADC block n acts
 // from frame (n + 1) L + 0.5 (ChainConfig::dac_lead_frames): the envelope of
@@ -147,12 +147,12 @@ class PumpEnvelopeFilter {
   // The pump envelope over the block just demodulated; returns the filtered
   // envelope matching that block's demodulator output.
   void push(double pump_re, double pump_im, double& out_re, double& out_im);
-  std::array<double, 3> weights() const { return w_; }
+  std::array<double, kDecimatorOrder> weights() const { return w_; }
 
  private:
-  std::array<double, 3> w_{};
-  std::array<double, 2> re_{};
-  std::array<double, 2> im_{};
+  std::array<double, kDecimatorOrder> w_{};
+  std::array<double, kDecimatorOrder - 1> re_{};  // envelopes of the blocks before
+  std::array<double, kDecimatorOrder - 1> im_{};
 };
 
 }  // namespace hrg::dsp
