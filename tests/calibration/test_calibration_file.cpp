@@ -114,3 +114,13 @@ TEST(CalibrationFile, BadFilesAreRefusedNamingTheKeyAndLine) {
   }
   CHECK_EQUAL(std::string(""), error_of(head));
 }
+
+// toml++ 3.3.0 misreads some non-ASCII code points and asserts on a malformed
+// table header: both are refused as errors with the place named, in every
+// build (the sanitizer build keeps assertions on elsewhere).
+TEST(CalibrationFile, NonAsciiTextAndMalformedHeadersAreErrorsNotCrashes) {
+  const std::string non_ascii = error_of("calibration_format = 1\n# 0.5 \xc2\xb0 phase\n");
+  CHECK_TEXT(contains(non_ascii, "gyro.toml:2:7: non-ASCII byte"), non_ascii.c_str());
+  const std::string header = error_of("calibration_format = 1\n[[[1]]]\n");
+  CHECK_TEXT(contains(header, "gyro.toml:2:"), header.c_str());
+}
