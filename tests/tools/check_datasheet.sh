@@ -5,9 +5,9 @@
 # tables and data tables, and every inlined PNG decoded.
 # Usage: check_datasheet.sh DEMO_EXE DATASHEET_PY OUT_DIR
 set -eu
+. "$(dirname "$0")/sheet_dom.sh"
 demo=$1 script=$2 out=$3
-browser=$(command -v chromium || command -v chromium-browser || true)
-if [ -z "$browser" ]; then
+if [ -z "$(sheet_browser)" ]; then
   echo "datasheet_renders: chromium not found; install it with 'tools/setup/deps.sh test'" \
     "(apt-get install chromium)" >&2
   exit 77
@@ -17,15 +17,12 @@ rm -rf "$out" && mkdir -p "$out"
 /usr/bin/python3 "$script" "$out/sheet.json" "$out"
 test -s "$out/summary.txt"
 # A fresh profile, no network, no background services.
-"$browser" --headless --no-sandbox --disable-gpu --disable-background-networking \
-  --disable-component-update --disable-sync --no-first-run --user-data-dir="$out/profile" \
-  --virtual-time-budget=5000 --dump-dom "file://$out/report.html" >"$out/dom.html" 2>"$out/chromium.log"
-count() { grep -o "$1" "$out/dom.html" | wc -l; }
-sections=$(count '<section id=')
-tables=$(count '<table class=')
-figures=$(count '<table class="figures"')
-images=$(count '<img id="plot-')
-decoded=$(sed -n 's/.*data-images-decoded="\([0-9]*\)".*/\1/p' "$out/dom.html")
+sheet_dump_dom "$out"
+sections=$(sheet_count "$out" '<section id=')
+tables=$(sheet_count "$out" '<table class=')
+figures=$(sheet_count "$out" '<table class="figures"')
+images=$(sheet_count "$out" '<img id="plot-')
+decoded=$(sheet_decoded "$out")
 echo "sections $sections, tables $tables (figure tables $figures), images $images, decoded ${decoded:-none}"
 fail=0
 [ "$sections" -eq 4 ] || { echo "expected 4 sections" >&2; fail=1; }

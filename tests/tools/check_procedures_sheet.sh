@@ -6,23 +6,20 @@
 # every figure named below present and every inlined PNG decoded.
 # Usage: check_procedures_sheet.sh HRG OUT_DIR
 set -eu
+. "$(dirname "$0")/sheet_dom.sh"
 hrg=$1 out=$2
-browser=$(command -v chromium || command -v chromium-browser || true)
 rm -rf "$out" && mkdir -p "$out"
 "$hrg" characterize --test all --short --turn-ons 2 --out "$out" --quiet
 test -s "$out/summary.txt"
-if [ -z "$browser" ]; then
+if [ -z "$(sheet_browser)" ]; then
   echo "check_procedures_sheet: chromium not found; install it with 'tools/setup/deps.sh test'" >&2
   exit 77
 fi
-"$browser" --headless --no-sandbox --disable-gpu --disable-background-networking \
-  --disable-component-update --disable-sync --no-first-run --user-data-dir="$out/profile" \
-  --virtual-time-budget=5000 --dump-dom "file://$out/report.html" >"$out/dom.html" 2>"$out/chromium.log"
-count() { grep -o "$1" "$out/dom.html" | wc -l; }
-sections=$(count '<section id=')
-figures=$(count '<table class="figures"')
-images=$(count '<img id="plot-')
-decoded=$(sed -n 's/.*data-images-decoded="\([0-9]*\)".*/\1/p' "$out/dom.html")
+sheet_dump_dom "$out"
+sections=$(sheet_count "$out" '<section id=')
+figures=$(sheet_count "$out" '<table class="figures"')
+images=$(sheet_count "$out" '<img id="plot-')
+decoded=$(sheet_decoded "$out")
 echo "sections $sections (figure tables $figures), images $images, decoded ${decoded:-none}"
 fail=0
 [ "$sections" -eq 6 ] || { echo "expected 6 sections" >&2; fail=1; }
