@@ -60,14 +60,9 @@ bool parse_timestamp(std::string_view s, uint64_t& t_ns, std::string& error) {
   return true;
 }
 
-bool parse_frame(std::string_view s, LoggedFrame& out, std::string& error) {
-  const auto hash = s.find('#');
-  if (hash == std::string_view::npos) {
-    error = "frame has no '#' between identifier and data";
-    return false;
-  }
-  const std::string_view id_text = s.substr(0, hash);
-  std::string_view data = s.substr(hash + 1);
+// The identifier before '#': 3 hex digits (standard) or 8 (extended, with
+// CAN_ERR_FLAG marking an error frame). Fills id, extended and error_frame.
+bool parse_identifier(std::string_view id_text, LoggedFrame& out, std::string& error) {
   if (id_text.size() != 3 && id_text.size() != 8) {
     error = "identifier must have 3 (standard) or 8 (extended) hex digits";
     return false;
@@ -81,9 +76,6 @@ bool parse_frame(std::string_view s, LoggedFrame& out, std::string& error) {
     }
     id = (id << 4) | static_cast<uint32_t>(v);
   }
-  out.error_frame = false;
-  out.remote = false;
-  out.frame = hal::CanFrame{};
   if (id_text.size() == 8) {
     out.error_frame = (id & kErrFlag) != 0;
     if ((id & ~(kErrFlag | kMaxExtendedId)) != 0) {
@@ -97,24 +89,26 @@ bool parse_frame(std::string_view s, LoggedFrame& out, std::string& error) {
     return false;
   }
   out.frame.id = id;
-  if (!data.empty() && data.front() == '#') {
-    error = "CAN FD frames (##) are not classic CAN";
-    return false;
-  }
-  if (!data.empty() && (data.front() == 'R' || data.front() == 'r')) {
-    out.remote = true;
-    data.remove_prefix(1);
-    if (data.size() == 1 && data[0] >= '0' && data[0] <= '8') {
-      out.frame.len = static_cast<uint8_t>(data[0] - '0');
-      return true;
-    }
-    if (!data.empty()) {
-      error = "remote frame has trailing characters";
-      return false;
-    }
+  return true;
+}
+
+// After "R": nothing, or the requested length 0-8.
+bool parse_remote(std::string_view data, LoggedFrame& out, std::string& error) {
+  out.remote = true;
+  if (data.size() == 1 && data[0] >= '0' && data[0] <= '8') {
+    out.frame.len = static_cast<uint8_t>(data[0] - '0');
     return true;
   }
-  // candump -l writes data without separators; cansend-style dots are accepted.
+  if (!data.empty()) {
+    error = "remote frame has trailing characters";
+    return false;
+  }
+  return true;
+}
+
+// Up to 8 bytes as hex pairs. candump -l writes them without separators;
+// cansend-style dots are accepted.
+bool parse_data(std::string_view data, LoggedFrame& out, std::string& error) {
   std::size_t n = 0;
   std::size_t i = 0;
   while (i < data.size()) {
@@ -141,6 +135,27 @@ bool parse_frame(std::string_view s, LoggedFrame& out, std::string& error) {
   }
   out.frame.len = static_cast<uint8_t>(n);
   return true;
+}
+
+bool parse_frame(std::string_view s, LoggedFrame& out, std::string& error) {
+  const auto hash = s.find('#');
+  if (hash == std::string_view::npos) {
+    error = "frame has no '#' between identifier and data";
+    return false;
+  }
+  out.error_frame = false;
+  out.remote = false;
+  out.frame = hal::CanFrame{};
+  if (!parse_identifier(s.substr(0, hash), out, error)) return false;
+  std::string_view data = s.substr(hash + 1);
+  if (!data.empty() && data.front() == '#') {
+    error = "CAN FD frames (##) are not classic CAN";
+    return false;
+  }
+  if (!data.empty() && (data.front() == 'R' || data.front() == 'r')) {
+    return parse_remote(data.substr(1), out, error);
+  }
+  return parse_data(data, out, error);
 }
 
 }  // namespace

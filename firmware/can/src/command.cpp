@@ -38,6 +38,100 @@ bool in_range(const SignalDef& s, const hal::CanFrame& f) {
   return v >= s.min - half_lsb && v <= s.max + half_lsb;
 }
 
+// The result of one check and its reply detail.
+struct Verdict {
+  CommandResult result;
+  uint8_t detail;
+};
+constexpr Verdict kAccepted{CommandResult::accepted, 0};
+
+// Checks that need only the frame and the counter state, in the documented
+// order: length, CRC, reserved bits, counter, every payload value in its DBC
+// range. `counter` is set once the CRC holds (the reply echoes it).
+Verdict check_frame(const MessageDef& m, const hal::CanFrame& frame, int last_counter,
+                    uint8_t& counter) {
+  if (frame.len != m.dlc) return {CommandResult::bad_length, frame.len};
+  if (command_crc8(frame.id, frame.data.data(), static_cast<uint8_t>(m.dlc - 1)) !=
+      frame.data[m.dlc - 1]) {
+    return {CommandResult::bad_checksum, 0};
+  }
+  counter = static_cast<uint8_t>(decode_raw(counter_sig(m), frame));
+  if (reserved_nibble(m, frame) != 0) return {CommandResult::reserved_bits, 0};
+  if (static_cast<int>(counter) == last_counter) return {CommandResult::repeated_counter, 0};
+  for (std::size_t i = 0; i + 2 < m.signals.size(); ++i) {
+    if (!in_range(m.signals[i], frame)) {
+      return {CommandResult::out_of_range, static_cast<uint8_t>(i)};
+    }
+  }
+  return kAccepted;
+}
+
+Verdict wrong_state(const ControllerView& st) {
+  return {CommandResult::wrong_state, static_cast<uint8_t>(st.mode)};
+}
+
+Verdict unsafe(UnsafeReason r) { return {CommandResult::unsafe, static_cast<uint8_t>(r)}; }
+
+Verdict check_set_mode(const MessageDef& m, const hal::CanFrame& frame, const ControllerView& st,
+                       Command& c) {
+  c.mode = static_cast<Mode>(decode_raw(m.signals[sig::target_mode], frame));
+  // The controller reaches the other modes itself; only these are commandable.
+  if (c.mode != Mode::safe && c.mode != Mode::ring_up) {
+    return {CommandResult::out_of_range, sig::target_mode};
+  }
+  if (c.mode == Mode::ring_up) {
+    if (st.mode != Mode::safe && st.mode != Mode::fault) return wrong_state(st);
+    if (st.faults != 0 || st.fault_input) return unsafe(UnsafeReason::fault_active);
+  }
+  return kAccepted;
+}
+
+Verdict check_window(const MessageDef& m, const hal::CanFrame& frame, const ControllerView& st,
+                     Command& c) {
+  c.window_period_s = decode_signal(m.signals[sig::period_s], frame);
+  c.window_length_s = decode_signal(m.signals[sig::length_s], frame);
+  if (st.mode == Mode::free_decay) return wrong_state(st);
+  // Half an LSB of slack so a length of exactly a quarter passes.
+  if (c.window_length_s >
+      kMaxWindowFraction * c.window_period_s + 0.5 * m.signals[sig::length_s].factor) {
+    return unsafe(UnsafeReason::window_too_long);
+  }
+  return kAccepted;
+}
+
+Verdict check_agc(const MessageDef& m, const hal::CanFrame& frame, const ControllerView& st,
+                  Command& c) {
+  c.agc_setpoint_v = decode_signal(m.signals[sig::setpoint_v], frame);
+  if (st.mode == Mode::free_decay) return wrong_state(st);
+  const double step = c.agc_setpoint_v - st.agc_setpoint_v;
+  const double allowed =
+      kMaxSetPointStep * st.agc_setpoint_v + 0.5 * m.signals[sig::setpoint_v].factor;
+  if (st.mode == Mode::operate && (step > allowed || -step > allowed)) {
+    return unsafe(UnsafeReason::set_point_step);
+  }
+  return kAccepted;
+}
+
+// The mode and safety rules of a well-formed command; fills its payload.
+Verdict check_rules(const MessageDef& m, const hal::CanFrame& frame, const ControllerView& st,
+                    Command& c) {
+  const bool is_setting = c.id == Cmd::ident || c.id == Cmd::window || c.id == Cmd::agc;
+  if (is_setting && !st.accepts_settings) return wrong_state(st);
+  switch (c.id) {
+    case Cmd::set_mode: return check_set_mode(m, frame, st, c);
+    case Cmd::ident:
+      c.ident_start = decode_raw(m.signals[sig::action], frame) == 1;
+      if (c.ident_start ? (st.mode != Mode::operate || st.ident_active) : !st.ident_active) {
+        return wrong_state(st);
+      }
+      return kAccepted;
+    case Cmd::window: return check_window(m, frame, st, c);
+    case Cmd::agc: return check_agc(m, frame, st, c);
+    case Cmd::status_request: return kAccepted;
+  }
+  return {CommandResult::unknown_command, 0};
+}
+
 }  // namespace
 
 const char* to_string(CommandResult r) {
@@ -94,96 +188,25 @@ CommandOutcome CommandValidator::process(const hal::CanFrame& frame, const Contr
   CommandOutcome out;
   if (frame.extended || frame.id < kCommandIdFirst || frame.id > kCommandIdLast) return out;
   out.for_us = true;
-  auto refuse = [&](CommandResult r, uint8_t counter, uint8_t detail) {
-    out.result = r;
-    out.detail = detail;
-    out.reply = make_reply(frame.id, counter, r, detail);
-    return out;
-  };
   const std::size_t index = frame.id - kCommandIdFirst;
-  if (index >= kCommandCount) return refuse(CommandResult::unknown_command, 0, 0);
-  const MessageDef& m = kCommands[index];
-  if (frame.len != m.dlc) return refuse(CommandResult::bad_length, 0, frame.len);
-  if (command_crc8(frame.id, frame.data.data(), static_cast<uint8_t>(m.dlc - 1)) !=
-      frame.data[m.dlc - 1]) {
-    return refuse(CommandResult::bad_checksum, 0, 0);
-  }
-  const auto counter = static_cast<uint8_t>(decode_raw(counter_sig(m), frame));
-  if (reserved_nibble(m, frame) != 0) return refuse(CommandResult::reserved_bits, counter, 0);
-  if (static_cast<int>(counter) == last_counter_) {
-    return refuse(CommandResult::repeated_counter, counter, 0);
-  }
-  for (std::size_t i = 0; i + 2 < m.signals.size(); ++i) {
-    if (!in_range(m.signals[i], frame)) {
-      return refuse(CommandResult::out_of_range, counter, static_cast<uint8_t>(i));
+  uint8_t counter = 0;
+  Verdict v{CommandResult::unknown_command, 0};
+  if (index < kCommandCount) {
+    v = check_frame(kCommands[index], frame, last_counter_, counter);
+    if (v.result == CommandResult::accepted) {
+      out.command.id = static_cast<Cmd>(index);
+      out.command.counter = counter;
+      v = check_rules(kCommands[index], frame, st, out.command);
     }
   }
-  const auto mode_detail = static_cast<uint8_t>(st.mode);
-  Command c;
-  c.id = static_cast<Cmd>(index);
-  c.counter = counter;
-  const bool is_setting = c.id == Cmd::ident || c.id == Cmd::window || c.id == Cmd::agc;
-  if (is_setting && !st.accepts_settings) {
-    return refuse(CommandResult::wrong_state, counter, mode_detail);
+  out.result = v.result;
+  out.detail = v.detail;
+  out.reply = make_reply(frame.id, counter, v.result, v.detail);
+  if (v.result == CommandResult::accepted) {
+    last_counter_ = counter;
+  } else {
+    out.command = Command{};
   }
-  switch (c.id) {
-    case Cmd::set_mode: {
-      c.mode = static_cast<Mode>(decode_raw(m.signals[sig::target_mode], frame));
-      // The controller reaches the other modes itself; only these are commandable.
-      if (c.mode != Mode::safe && c.mode != Mode::ring_up) {
-        return refuse(CommandResult::out_of_range, counter, sig::target_mode);
-      }
-      if (c.mode == Mode::ring_up) {
-        if (st.mode != Mode::safe && st.mode != Mode::fault) {
-          return refuse(CommandResult::wrong_state, counter, mode_detail);
-        }
-        if (st.faults != 0 || st.fault_input) {
-          return refuse(CommandResult::unsafe, counter,
-                        static_cast<uint8_t>(UnsafeReason::fault_active));
-        }
-      }
-      break;
-    }
-    case Cmd::ident:
-      c.ident_start = decode_raw(m.signals[sig::action], frame) == 1;
-      if (c.ident_start ? (st.mode != Mode::operate || st.ident_active) : !st.ident_active) {
-        return refuse(CommandResult::wrong_state, counter, mode_detail);
-      }
-      break;
-    case Cmd::window:
-      c.window_period_s = decode_signal(m.signals[sig::period_s], frame);
-      c.window_length_s = decode_signal(m.signals[sig::length_s], frame);
-      if (st.mode == Mode::free_decay) {
-        return refuse(CommandResult::wrong_state, counter, mode_detail);
-      }
-      // Half an LSB of slack so a length of exactly a quarter passes.
-      if (c.window_length_s >
-          kMaxWindowFraction * c.window_period_s + 0.5 * m.signals[sig::length_s].factor) {
-        return refuse(CommandResult::unsafe, counter,
-                      static_cast<uint8_t>(UnsafeReason::window_too_long));
-      }
-      break;
-    case Cmd::agc: {
-      c.agc_setpoint_v = decode_signal(m.signals[sig::setpoint_v], frame);
-      if (st.mode == Mode::free_decay) {
-        return refuse(CommandResult::wrong_state, counter, mode_detail);
-      }
-      const double step = c.agc_setpoint_v - st.agc_setpoint_v;
-      const double allowed =
-          kMaxSetPointStep * st.agc_setpoint_v + 0.5 * m.signals[sig::setpoint_v].factor;
-      if (st.mode == Mode::operate && (step > allowed || -step > allowed)) {
-        return refuse(CommandResult::unsafe, counter,
-                      static_cast<uint8_t>(UnsafeReason::set_point_step));
-      }
-      break;
-    }
-    case Cmd::status_request: break;
-  }
-  last_counter_ = counter;
-  out.result = CommandResult::accepted;
-  out.detail = 0;
-  out.command = c;
-  out.reply = make_reply(frame.id, counter, CommandResult::accepted, 0);
   return out;
 }
 
