@@ -64,6 +64,7 @@ void DspChainPort::process(std::span<const hal::q31_t> adc, std::span<hal::q31_t
     return;
   }
   static_cast<dsp::ChainOutputs&>(out) = chain_.outputs();
+  out.nco_phase = chain_.nco_phase();
 }
 
 }  // namespace hrg::fw

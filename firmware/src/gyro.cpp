@@ -17,6 +17,7 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, ResonatorIdentifier& identifie
       monitor_(cfg.monitor),
       scheduler_(cfg.windows),
       output_(cfg.angular_gain, 1.0 / kBaseRateHz),
+      envelope_(cfg.envelope),
       link_(board.can, kCanRestartRuns) {
   monitor_.set_amplitude_set_v(cfg_.amplitude_set_v);
   const hal::ConverterInfo adc = board.adc.info();
@@ -274,10 +275,17 @@ void Gyro::task_solve(Gyro& g) {
 void Gyro::task_telemetry(Gyro& g) {
   const GyroStatus& st = g.status_;
   can::TelemetrySnapshot& s = g.snapshot_;
-  s.cx_v = st.chain.quad.cx;
-  s.sx_v = st.chain.quad.sx;
-  s.cy_v = st.chain.quad.cy;
-  s.sy_v = st.chain.quad.sy;
+  g.envelope_.after_block(st.chain.t_s, st.chain.nco_phase, st.excitation_on);
+  const can::EnvelopeRow row =
+      g.envelope_.row(st.chain.quad.cx, st.chain.quad.sx, st.chain.quad.cy, st.chain.quad.sy);
+  s.cx_v = row.cx_v;
+  s.sx_v = row.sx_v;
+  s.cy_v = row.cy_v;
+  s.sy_v = row.sy_v;
+  s.row_t_s = row.t_s;
+  s.row_exc = row.exc;
+  s.row_ready = g.envelope_.ready();
+  s.f_ref_hz = g.envelope_.f_ref_hz();
   s.theta_a_rad = st.theta_unwrapped_rad;
   s.output_angle_rad = st.out_angle_rad;
   s.pll_freq_hz = st.chain.pll_freq_hz;

@@ -87,10 +87,11 @@ TEST(DbcAgreesWithCode, EveryMessageAndSignalOfTheCodeIsInTheDbc) {
   check_message(kReply, dbc());
   for (const auto& m : kCalibrationMessages)
     check_message(m, dbc());
+  check_message(kLabTable, dbc());
 }
 
 TEST(DbcAgreesWithCode, TheDbcHasNoMessageTheCodeDoesNotKnow) {
-  LONGS_EQUAL(kTelemetryCount + kCommandCount + 1 + kCalibrationMessageCount,
+  LONGS_EQUAL(kTelemetryCount + kCommandCount + 1 + kCalibrationMessageCount + 1,
               dbc().messages.size());
   for (const auto& m : dbc().messages)
     CHECK_TEXT(find_message(m.id) != nullptr, m.name.c_str());
@@ -136,6 +137,19 @@ TEST(DbcAgreesWithCode, FramesEncodedByTheFirmwareDecodeThroughTheDbc) {
   encode_telemetry(Tm::est_split, s, 7, f);
   DOUBLES_EQUAL(-0.0123, dbc().message(f.id)->signal("dw_s_rad_s")->decode(f), 1e-12);
   DOUBLES_EQUAL(7, dbc().message(f.id)->signal("seq")->decode(f), 0);
+  s.row_t_s = 3599.9995;
+  s.pump_v = 9.518;
+  s.row_exc = false;
+  encode_telemetry(Tm::row, s, 9, f);
+  DOUBLES_EQUAL(3599.9995, dbc().message(f.id)->signal("t_s")->decode(f), 1e-9);
+  DOUBLES_EQUAL(9.518, dbc().message(f.id)->signal("pump_v")->decode(f), 1e-12);
+  DOUBLES_EQUAL(0, dbc().message(f.id)->signal("exc")->decode(f), 0);
+  s.f_ref_hz = 4999.87312;
+  encode_telemetry(Tm::reference, s, 9, f);
+  DOUBLES_EQUAL(4999.87312, dbc().message(f.id)->signal("f_ref_hz")->decode(f), 1e-9);
+  f = encode_lab_table(-123.456789, 31.27, 3);
+  DOUBLES_EQUAL(-123.456789, dbc().message(f.id)->signal("rate_dps")->decode(f), 1e-12);
+  DOUBLES_EQUAL(31.27, dbc().message(f.id)->signal("temp_c")->decode(f), 1e-9);
 }
 
 TEST(DbcAgreesWithCode, BusLoadFromTheDbcIsBelowHalfAndMatchesCodeAndReadme) {

@@ -29,7 +29,10 @@ TelemetrySnapshot sample(int k) {
   s.cy_v = -0.004 * t;
   s.sy_v = 1e-5 * k;
   s.exc_on = (k / 400) % 2 == 0;
-  s.pump_v = 9.5;
+  s.row_exc = ((k - 7) / 400) % 2 == 0;  // the drive as applied lags the command
+  s.row_t_s = 0.1 + 1e-3 * k - 2.5e-3;   // the envelope's centre, 0.1 s after boot
+  s.f_ref_hz = 4999.87312;
+  s.pump_v = 9.5 + 1e-3 * k;
   s.temp_c = 31.25;
   s.pll_freq_hz = 4999.87310 + 1e-4 * k;
   s.angular_gain = 0.554;
@@ -37,22 +40,39 @@ TelemetrySnapshot sample(int k) {
   return s;
 }
 
-// Two seconds of default-rate telemetry; drops the frames for which `drop`
-// says so (message index, occurrence).
-std::string write_log(const std::set<std::pair<int, int>>& drop) {
+// The bench's rate at frame k (LAB_TABLE, logged after the frame's telemetry).
+double table_rate_dps(int k) { return 0.01 * k; }
+
+// Two seconds of default-rate telemetry, LAB_TABLE frames at the row rate
+// when `lab`; drops the frames for which `drop` says so (message index,
+// occurrence).
+std::string write_log(const std::set<std::pair<int, int>>& drop, bool lab = true) {
   const std::string path = "test_can_decode.log";
   hrg::can::CandumpLogWriter w(path);
   TelemetryEncoder enc(TelemetryConfig::defaults(), 1000);
   std::array<hrg::hal::CanFrame, kTelemetryCount> out;
   std::array<int, kTelemetryCount> seen{};
+  uint8_t lab_seq = 0;
   for (int k = 0; k < 2000; ++k) {
     const std::size_t n = enc.tick(sample(k), out);
     for (std::size_t j = 0; j < n; ++j) {
       const auto i = static_cast<int>(find_message(out[j].id) - kTelemetry.data());
       if (drop.count({i, seen[i]++}) == 0) w.write(out[j], kT0Ns + 1'000'000ull * k + 10 * j);
     }
+    if (lab && k % 10 == 9) {
+      w.write(encode_lab_table(table_rate_dps(k + 1), 24.5, lab_seq++),
+              kT0Ns + 1'000'000ull * k + 500);
+    }
   }
   return path;
+}
+
+hrg::can::CanDecodeOptions options(const std::string& log, const std::string& out) {
+  hrg::can::CanDecodeOptions o;
+  o.log_path = log;
+  o.out_path = out;
+  o.dbc_path = std::string(std::getenv("HRG_SOURCE_DIR")) + "/firmware/can/hrg.dbc";
+  return o;
 }
 
 }  // namespace
@@ -60,49 +80,84 @@ std::string write_log(const std::set<std::pair<int, int>>& drop) {
 TEST_GROUP(CanDecode){};
 
 TEST(CanDecode, RowsAreTheTransmittedSamplesAndLossesAreCountedPerMessage) {
-  // GIVEN a log that lost WAVE_X #100, WAVE_Y #300, #301, #302 and LOOPS #50, #51
+  // GIVEN a log that lost WAVE_X #10, WAVE_Y #30, #31, #32, ROW #50 and LOOPS #50, #51
   const int wx = static_cast<int>(Tm::wave_x);
   const int wy = static_cast<int>(Tm::wave_y);
+  const int rw = static_cast<int>(Tm::row);
   const int lp = static_cast<int>(Tm::loops);
   const std::string log =
-      write_log({{wx, 100}, {wy, 300}, {wy, 301}, {wy, 302}, {lp, 50}, {lp, 51}});
-  hrg::can::CanDecodeOptions o;
-  o.log_path = log;
-  o.out_path = "test_can_decode.csv";
-  o.dbc_path = std::string(std::getenv("HRG_SOURCE_DIR")) + "/firmware/can/hrg.dbc";
+      write_log({{wx, 10}, {wy, 30}, {wy, 31}, {wy, 32}, {rw, 50}, {lp, 50}, {lp, 51}});
+  const hrg::can::CanDecodeOptions o = options(log, "test_can_decode.csv");
   // WHEN it is decoded
   const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
-  // THEN 1000 samples less the 4 incomplete ones are rows
-  LONGS_EQUAL(996, s.rows);
+  // THEN 200 samples less the 5 incomplete ones are rows
+  LONGS_EQUAL(195, s.rows);
   LONGS_EQUAL(1, s.messages.at("HRG_WAVE_X").lost);
   LONGS_EQUAL(3, s.messages.at("HRG_WAVE_Y").lost);
+  LONGS_EQUAL(1, s.messages.at("HRG_ROW").lost);
   LONGS_EQUAL(2, s.messages.at("HRG_LOOPS").lost);
   LONGS_EQUAL(0, s.messages.at("HRG_ANGLE").lost);
   DOUBLES_EQUAL(0.554, s.angular_gain, 1e-12);
-  // The first HRG_LOOPS goes out at frame 7 (staggered by its table index 3).
-  DOUBLES_EQUAL(4999.87310 + 7e-4, s.f_ref_hz, 0.5e-5);
+  // The reference is HRG_REFERENCE's, not the PLL's frequency.
+  DOUBLES_EQUAL(4999.87312, s.f_ref_hz, 1e-9);
+  CHECK(s.has_lab_table);
   const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
-  LONGS_EQUAL(996, rec.rows());
-  STRCMP_EQUAL("1 of 1000", rec.metadata_value("can_lost_HRG_WAVE_X").c_str());
-  STRCMP_EQUAL("3 of 1000", rec.metadata_value("can_lost_HRG_WAVE_Y").c_str());
-  // AND each row holds the sample of its frame: WAVE_X goes out on even frames
-  // (k = 2 m), so row time t_s = 2 m ms and cx = 1.2 cos(0.3 t).
+  LONGS_EQUAL(195, rec.rows());
+  DOUBLES_EQUAL(4999.87312, rec.f_ref_hz(), 1e-9);
+  STRCMP_EQUAL("1 of 200", rec.metadata_value("can_lost_HRG_WAVE_X").c_str());
+  STRCMP_EQUAL("3 of 200", rec.metadata_value("can_lost_HRG_WAVE_Y").c_str());
+  // AND each row holds the sample of its frame at the firmware's row time
+  // (k = 10 m, t_s = 0.1 s + k ms - 2.5 ms), whatever the log's timestamps: the
+  // envelopes, the drive as applied, its command, the pump of that frame and
+  // the table's rate logged after it.
   const auto& t = rec.column("t_s");
-  const auto& cx = rec.column("cx_v");
-  const auto& cy = rec.column("cy_v");
-  const auto& exc = rec.column("exc");
-  const auto& f_ref = rec.column("f_ref_hz");
   for (std::size_t r = 0; r < rec.rows(); ++r) {
-    const int k = static_cast<int>(std::lround(t[r] * 1e3));
-    DOUBLES_EQUAL(1e-3 * k, t[r], 1e-9);
+    const int k = static_cast<int>(std::lround((t[r] - 0.1 + 2.5e-3) * 1e3));
+    LONGS_EQUAL(0, k % 10);
     const TelemetrySnapshot want = sample(k);
-    DOUBLES_EQUAL(want.cx_v, cx[r], 0.5e-6);
-    DOUBLES_EQUAL(want.cy_v, cy[r], 0.5e-6);
-    DOUBLES_EQUAL(want.exc_on ? 1.0 : 0.0, exc[r], 0);
-    CHECK(std::fabs(f_ref[r] - want.pll_freq_hz) < 0.011);  // latest LOOPS, <= 10 ms old
+    DOUBLES_EQUAL(want.row_t_s, t[r], 1e-9);
+    DOUBLES_EQUAL(want.cx_v, rec.column("cx_v")[r], 0.5e-6);
+    DOUBLES_EQUAL(want.cy_v, rec.column("cy_v")[r], 0.5e-6);
+    DOUBLES_EQUAL(want.row_exc ? 1.0 : 0.0, rec.column("exc")[r], 0);
+    DOUBLES_EQUAL(want.exc_on ? 1.0 : 0.0, rec.column("exc_cmd")[r], 0);
+    DOUBLES_EQUAL(want.pump_v, rec.column("pump_v")[r], 0.5e-3);
+    if (k == 0) continue;                                // before the bench's first frame
+    DOUBLES_EQUAL(24.5, rec.column("temp_c")[r], 1e-9);  // the chamber's, not STATUS
+    DOUBLES_EQUAL(table_rate_dps(k), rec.column("rate_dps")[r], 0.5e-6);
   }
   // AND the missing samples show as gaps, never filled in
   CHECK(rec.gaps().size() >= 2);
+  std::remove(log.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(CanDecode, WithoutTheBenchTheTemperatureIsTheGyroStatusAndNoRateIsMadeUp) {
+  const std::string log = write_log({}, false);
+  const hrg::can::CanDecodeOptions o = options(log, "test_can_decode_nolab.csv");
+  const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
+  CHECK_FALSE(s.has_lab_table);
+  const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
+  CHECK_FALSE(rec.has_column("rate_dps"));
+  for (std::size_t r = 10; r < rec.rows(); ++r)
+    DOUBLES_EQUAL(31.25, rec.column("temp_c")[r], 1e-9);
+  std::remove(log.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(CanDecode, ALogWithoutTheReferenceIsRefusedUnlessItIsGiven) {
+  std::set<std::pair<int, int>> drop;
+  for (int i = 0; i < 2; ++i)
+    drop.insert({static_cast<int>(Tm::reference), i});
+  const std::string log = write_log(drop);
+  hrg::can::CanDecodeOptions o = options(log, "test_can_decode_ref.csv");
+  try {
+    hrg::can::can_decode(o);
+    FAIL("decoded without the reference");
+  } catch (const std::runtime_error& e) {
+    STRCMP_CONTAINS("HRG_REFERENCE", e.what());
+  }
+  o.f_ref_hz = 4999.87312;
+  LONGS_EQUAL(200, hrg::can::can_decode(o).rows);
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
 }
@@ -123,7 +178,7 @@ TEST(CanDecode, ALogWithoutTheAngularGainIsRefusedUnlessItIsGiven) {
     STRCMP_CONTAINS("angular_gain", e.what());
   }
   o.angular_gain = 0.55;
-  LONGS_EQUAL(1000, hrg::can::can_decode(o).rows);
+  LONGS_EQUAL(200, hrg::can::can_decode(o).rows);
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
 }

@@ -10,6 +10,7 @@
 
 #include "can/candump_log.hpp"
 #include "can/dbc.hpp"
+#include "firmware/can/signal.hpp"
 #include "recording/recording_writer.hpp"
 
 namespace hrg::can {
@@ -20,10 +21,12 @@ namespace {
 struct Layout {
   const DbcMessage* wave_x;
   const DbcMessage* wave_y;
+  const DbcMessage* row;
+  const DbcMessage* reference;
   const DbcMessage* loops;
-  const DbcMessage* pump;
   const DbcMessage* status;
   const DbcMessage* info;
+  const DbcMessage* lab_table;
 };
 
 const DbcMessage& need(const Dbc& dbc, std::string_view name, const std::string& path) {
@@ -61,45 +64,49 @@ const DbcMessage* known_message(const Dbc& dbc, const LoggedFrame& lf) {
   return m;
 }
 
+// Sequence-counter bookkeeping of one message.
+void count_frame(const DbcMessage& m, const hal::CanFrame& f, std::map<uint32_t, int>& last_seq,
+                 MessageLosses& ml) {
+  ++ml.frames;
+  const DbcSignal* seq = m.signal("seq");
+  if (seq == nullptr) return;
+  const int s = static_cast<int>(seq->decode_raw(f));
+  const auto it = last_seq.find(m.id);
+  if (it != last_seq.end()) ml.lost += static_cast<uint64_t>((s - it->second - 1 + 256) % 256);
+  last_seq[m.id] = s;
+}
+
 // Pass 1: metadata (K, reference frequency), the first timestamp and the
-// losses per message (from each message's sequence counter). Returns the
-// first frame's time, ns.
-uint64_t scan_log(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
-                  CanDecodeSummary& sum) {
+// losses per message (from each message's sequence counter).
+void scan_log(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L, CanDecodeSummary& sum) {
   std::map<uint32_t, int> last_seq;
   std::optional<double> k = o.angular_gain;
   std::optional<double> f_ref = o.f_ref_hz;
-  uint64_t t0_ns = 0;
   for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
-    if (sum.frames++ == 0) {
-      t0_ns = lf.t_ns;
-      sum.t0_s = static_cast<double>(lf.t_ns) * 1e-9;
-    }
+    if (sum.frames++ == 0) sum.t0_s = static_cast<double>(lf.t_ns) * 1e-9;
+    sum.span_s = static_cast<double>(lf.t_ns) * 1e-9 - sum.t0_s;
+    if (!lf.error_frame) sum.bus_bits += fw::can::worst_case_frame_bits(lf.frame.len);
     const DbcMessage* m = known_message(dbc, lf);
     if (m == nullptr) {
       ++sum.unknown_frames;
       return;
     }
-    MessageLosses& ml = sum.messages[m->name];
-    ++ml.frames;
-    if (const DbcSignal* seq = m->signal("seq")) {
-      const int s = static_cast<int>(seq->decode_raw(lf.frame));
-      const auto it = last_seq.find(m->id);
-      if (it != last_seq.end()) ml.lost += static_cast<uint64_t>((s - it->second - 1 + 256) % 256);
-      last_seq[m->id] = s;
-    }
+    count_frame(*m, lf.frame, last_seq, sum.messages[m->name]);
     if (m == L.info && !k) k = value(*m, "angular_gain", lf.frame);
-    if (m == L.loops && !f_ref) f_ref = value(*m, "pll_freq_hz", lf.frame);
+    if (m == L.reference && !f_ref) f_ref = value(*m, "f_ref_hz", lf.frame);
+    if (m == L.lab_table) sum.has_lab_table = true;
   });
   if (!k)
     throw std::runtime_error(o.log_path +
                              ": no HRG_INFO frame gives angular_gain; pass --angular-gain");
-  if (!f_ref)
+  if (!f_ref) {
     throw std::runtime_error(o.log_path +
-                             ": no HRG_LOOPS frame gives the reference frequency; pass --f-ref-hz");
+                             ": no HRG_REFERENCE frame gives the reference frequency of the "
+                             "envelopes (a firmware of protocol 2 sends it each second); pass "
+                             "--f-ref-hz");
+  }
   sum.angular_gain = *k;
   sum.f_ref_hz = *f_ref;
-  return t0_ns;
 }
 
 std::vector<std::pair<std::string, std::string>> recording_metadata(const CanDecodeOptions& o,
@@ -117,54 +124,83 @@ std::vector<std::pair<std::string, std::string>> recording_metadata(const CanDec
   return meta;
 }
 
-// Pass 2: rows. A WAVE_X waits for the WAVE_Y with the same seq; the slower
-// messages give their latest values.
-void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L, uint64_t t0_ns,
+// The parts of one recording row as they arrive: HRG_WAVE_X, HRG_WAVE_Y and
+// HRG_ROW of the same seq, in that order within a base frame.
+struct PendingRow {
+  int parts = 0;  // 1 after WAVE_X, 2 after WAVE_Y
+  int seq = 0;
+  double cx = 0, sx = 0, exc_cmd = 0, cy = 0, sy = 0;
+};
+
+// The slower messages' latest values.
+struct Latest {
+  double temp_c = 0, mode = 0, pll_hz = 0, rate_dps = 0;
+};
+
+void take_latest(const Layout& L, const DbcMessage* m, const hal::CanFrame& f, bool lab_temp,
+                 Latest& v) {
+  if (m == L.status) {
+    if (!lab_temp) v.temp_c = value(*m, "temp_c", f);
+    v.mode = value(*m, "mode", f);
+  }
+  if (m == L.loops) v.pll_hz = value(*m, "pll_freq_hz", f);
+  if (m == L.lab_table) {
+    v.rate_dps = value(*m, "rate_dps", f);
+    v.temp_c = value(*m, "temp_c", f);
+  }
+}
+
+// A wave or row frame into the pending row; true when the row is complete.
+bool take_row_part(const Layout& L, const DbcMessage* m, const hal::CanFrame& f, PendingRow& p,
+                   uint64_t& unpaired) {
+  const int seq = static_cast<int>(value(*m, "seq", f));
+  if (m == L.wave_x) {
+    if (p.parts != 0) ++unpaired;
+    p = PendingRow{1, seq, value(*m, "cx_v", f), value(*m, "sx_v", f), value(*m, "exc", f)};
+    return false;
+  }
+  const int want = m == L.wave_y ? 1 : 2;
+  if (p.parts != want || seq != p.seq) {
+    ++unpaired;
+    p.parts = 0;
+    return false;
+  }
+  if (m == L.wave_y) {
+    p.cy = value(*m, "cy_v", f);
+    p.sy = value(*m, "sy_v", f);
+    p.parts = 2;
+    return false;
+  }
+  p.parts = 0;
+  return true;
+}
+
+// Pass 2: rows. The row's time is the firmware's (HRG_ROW.t_s), never the
+// log's: the envelopes are against ph = 2 pi f_ref t at exactly that time.
+void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
                 recording::RecordingWriter& writer, CanDecodeSummary& sum) {
-  double pump_v = 0, temp_c = 0, mode = 0, f_row = sum.f_ref_hz;
-  bool have_x = false;
-  int x_seq = 0;
-  double x_t = 0, cx = 0, sx = 0, exc = 0, last_t = -1;
+  PendingRow p;
+  Latest v;
+  double last_t = -1;
   for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
     const DbcMessage* m = known_message(dbc, lf);
     if (m == nullptr) return;
     const hal::CanFrame& f = lf.frame;
-    // Relative time in integer nanoseconds first: epoch seconds in a double
-    // would keep only ~0.2 us.
-    const double t = static_cast<double>(static_cast<int64_t>(lf.t_ns - t0_ns)) * 1e-9;
-    if (m == L.pump) pump_v = value(*m, "pump_v", f);
-    if (m == L.status) {
-      temp_c = value(*m, "temp_c", f);
-      mode = value(*m, "mode", f);
+    take_latest(L, m, f, sum.has_lab_table, v);
+    if (m != L.wave_x && m != L.wave_y && m != L.row) return;
+    if (!take_row_part(L, m, f, p, sum.unpaired_wave)) return;
+    const double t = value(*m, "t_s", f);
+    if (t <= last_t) {  // not after the previous row: cannot order it
+      ++sum.unpaired_wave;
+      return;
     }
-    if (m == L.loops) f_row = value(*m, "pll_freq_hz", f);
-    if (m == L.wave_x) {
-      if (have_x) ++sum.unpaired_wave;
-      have_x = true;
-      x_seq = static_cast<int>(value(*m, "seq", f));
-      x_t = t;
-      cx = value(*m, "cx_v", f);
-      sx = value(*m, "sx_v", f);
-      exc = value(*m, "exc", f);
-    }
-    if (m == L.wave_y) {
-      if (!have_x || static_cast<int>(value(*m, "seq", f)) != x_seq) {
-        ++sum.unpaired_wave;
-        have_x = false;
-        return;
-      }
-      have_x = false;
-      if (x_t <= last_t) {  // same log timestamp as the previous row: cannot order it
-        ++sum.unpaired_wave;
-        return;
-      }
-      last_t = x_t;
-      const double row[] = {
-          x_t,    cx,    sx,  value(*m, "cy_v", f), value(*m, "sy_v", f), exc, pump_v,
-          temp_c, f_row, mode};
-      writer.write_row(row);
-      ++sum.rows;
-    }
+    last_t = t;
+    std::vector<double> row = {
+        t,        p.cx,   p.sx,      p.cy,    p.sy, value(*m, "exc", f), value(*m, "pump_v", f),
+        v.temp_c, v.mode, p.exc_cmd, v.pll_hz};
+    if (sum.has_lab_table) row.push_back(v.rate_dps);
+    writer.write_row(row);
+    ++sum.rows;
   });
 }
 
@@ -174,15 +210,18 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
   const std::string dbc_path = o.dbc_path.empty() ? std::string(HRG_DEFAULT_DBC) : o.dbc_path;
   const Dbc dbc = load_dbc(dbc_path);
   const Layout L{&need(dbc, "HRG_WAVE_X", dbc_path), &need(dbc, "HRG_WAVE_Y", dbc_path),
-                 &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_PUMP", dbc_path),
-                 &need(dbc, "HRG_STATUS", dbc_path), &need(dbc, "HRG_INFO", dbc_path)};
+                 &need(dbc, "HRG_ROW", dbc_path),    &need(dbc, "HRG_REFERENCE", dbc_path),
+                 &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_STATUS", dbc_path),
+                 &need(dbc, "HRG_INFO", dbc_path),   dbc.message("LAB_TABLE")};
   CanDecodeSummary sum;
-  const uint64_t t0_ns = scan_log(o, dbc, L, sum);
-  recording::RecordingWriter writer(
-      o.out_path,
-      {"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc", "pump_v", "temp_c", "f_ref_hz", "mode"},
-      sum.f_ref_hz, sum.angular_gain, recording_metadata(o, dbc_path, sum));
-  write_rows(o, dbc, L, t0_ns, writer, sum);
+  sum.bitrate_bps = dbc.bitrate_bps;
+  scan_log(o, dbc, L, sum);
+  std::vector<std::string> columns = {"t_s",    "cx_v",   "sx_v", "cy_v",    "sy_v",  "exc",
+                                      "pump_v", "temp_c", "mode", "exc_cmd", "pll_hz"};
+  if (sum.has_lab_table) columns.emplace_back("rate_dps");
+  recording::RecordingWriter writer(o.out_path, columns, sum.f_ref_hz, sum.angular_gain,
+                                    recording_metadata(o, dbc_path, sum));
+  write_rows(o, dbc, L, writer, sum);
   writer.close();
   return sum;
 }
@@ -234,6 +273,13 @@ int can_decode_main(std::span<char* const> args) {
       }
     }
     if (lost == 0) std::printf("can-decode: no frame lost\n");
+    if (s.span_s > 0 && s.bitrate_bps > 0) {
+      const double bps = s.bus_bits / s.span_s;
+      std::printf(
+          "can-decode: bus load %.2f %% of %u bit/s (%.0f bit/s at worst-case stuffing "
+          "over %.1f s)\n",
+          100.0 * bps / s.bitrate_bps, s.bitrate_bps, bps, s.span_s);
+    }
     if (s.unpaired_wave > 0) {
       std::printf("can-decode: %llu wave frames without their pair (no row)\n",
                   static_cast<unsigned long long>(s.unpaired_wave));

@@ -14,7 +14,7 @@ struct CanDecodeOptions {
   std::string out_path;                // .csv or .csv.gz
   std::string dbc_path;                // empty: the repository's firmware/can/hrg.dbc
   std::optional<double> angular_gain;  // overrides HRG_INFO.angular_gain
-  std::optional<double> f_ref_hz;      // overrides the first HRG_LOOPS.pll_freq_hz
+  std::optional<double> f_ref_hz;      // overrides HRG_REFERENCE.f_ref_hz (lost frames)
 };
 
 // Per-message frame counts and losses counted from the rolling `seq`.
@@ -31,15 +31,25 @@ struct CanDecodeSummary {
   std::map<std::string, MessageLosses> messages;  // by DBC message name
   double f_ref_hz = 0;
   double angular_gain = 0;
-  double t0_s = 0;  // log time of the first frame; rows count from it
+  double t0_s = 0;             // log time of the first frame
+  bool has_lab_table = false;  // LAB_TABLE frames give rate_dps and temp_c
+  // Bus load of the log: every frame at its worst-case stuffed length
+  // (11-bit identifiers; error frames left out) over the span of the log.
+  double bus_bits = 0;
+  double span_s = 0;
+  unsigned bitrate_bps = 0;  // the DBC's BS_
 };
 
 // Turns a candump -l log of HRG telemetry into an hrg-recording v1, decoding
-// with the DBC. Rows are the HRG_WAVE_X/HRG_WAVE_Y pairs (same seq); pump_v,
-// temp_c, f_ref_hz and mode are the latest HRG_PUMP, HRG_STATUS and HRG_LOOPS
-// values. Losses are counted per message from the sequence counters and
-// written to the metadata. Throws std::runtime_error (naming file and line) on
-// unreadable input or when K or the reference frequency is unknown.
+// with the DBC. Rows are the HRG_WAVE_X/HRG_WAVE_Y/HRG_ROW triples (same
+// seq): envelopes against the fixed reference of HRG_REFERENCE (metadata
+// f_ref_hz) at the firmware's row time, exc the drive as applied, pump_v of
+// the same block; rate_dps and temp_c from the latest LAB_TABLE when the log
+// has any (else temp_c from HRG_STATUS and no rate); mode, exc_cmd (the
+// excitation command) and pll_hz the latest values. Losses are counted per
+// message from the sequence counters and written to the metadata. Throws
+// std::runtime_error (naming file and line) on unreadable input or when K or
+// the reference frequency is unknown.
 CanDecodeSummary can_decode(const CanDecodeOptions& options);
 
 // `hrg can-decode LOG -o REC.csv [--dbc FILE] [--angular-gain K] [--f-ref-hz F]`.

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "firmware/app/firmware_config.hpp"
 
+#include <cmath>
+
+#include "dsp/demodulator.hpp"
+
 namespace hrg::fw::app {
 
 void apply_window_plan(WindowConfig& w, WindowPlan plan) {
@@ -55,6 +59,24 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
   cfg.chain.amplitude_setpoint_v = cfg.gyro.amplitude_set_v;
   cfg.gyro.monitor.amplitude_set_v = cfg.gyro.amplitude_set_v;
   cfg.estimator.angular_gain = cfg.gyro.angular_gain;
+  cfg.gyro.envelope = envelope_reference_config(cfg.chain, conv);
+}
+
+can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& chain,
+                                                       const ConverterLayout& conv) {
+  can::EnvelopeReferenceConfig e;
+  e.f_ref_hz = chain.f_center_hz;
+  const double l = static_cast<double>(chain.block_frames);
+  e.block_period_s = l / chain.sample_rate_hz;
+  e.centre_blocks = dsp::kDecimatorOrder / 2;
+  // The DAC's pipeline is counted once more on top of the chain's lead (which
+  // holds it already): a row is called drive-free one block late rather
+  // than early.
+  e.drive_free_blocks =
+      static_cast<uint32_t>(1.0 + std::ceil((chain.dac_lead_frames + conv.dac_latency_samples +
+                                             (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
+                                            l));
+  return e;
 }
 
 }  // namespace hrg::fw::app

@@ -91,6 +91,26 @@ constexpr SignalDef kCanStats[] = {
   {"seq", 56, 8, false, 1, 0, 0, 255, ""},
 };
 
+// One row of an audit-grade recording (see telemetry.hpp, EnvelopeReference):
+// the envelope's time and the drive state as applied, with the pump at the
+// same block; rows pair with HRG_WAVE_X/HRG_WAVE_Y by `seq`.
+constexpr SignalDef kRow[] = {
+  {"t_s", 0, 32, false, 1e-4, 0, 0, 4294967295.0 * 1e-4, "s"},
+  {"pump_v", 32, 16, false, 1e-3, 0, 0, 65.535, "V"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+  {"exc", 56, 1, false, 1, 0, 0, 1, ""},
+};
+constexpr SignalDef kReference[] = {
+  {"f_ref_hz", 0, 32, false, 1e-5, 0, 0, 4294967295.0 * 1e-5, "Hz"},
+  {"seq", 32, 8, false, 1, 0, 0, 255, ""},
+};
+// The test bench's rate table and thermal chamber (not the gyro).
+constexpr SignalDef kLabTableSignals[] = {
+  {"rate_dps", 0, 32, true, 1e-6, 0, -2147483648.0 * 1e-6, 2147483647.0 * 1e-6, "deg/s"},
+  {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
+  {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+};
+
 // Commands: [payload..., counter (4 bits) + 4 reserved zero bits, CRC-8].
 constexpr SignalDef kSetMode[] = {
   {"mode", 0, 8, false, 1, 0, 0, 7, ""},
@@ -166,8 +186,8 @@ constexpr bool fits(std::span<const SignalDef> sigs, uint8_t dlc) {
 
 // clang-format off
 const std::array<MessageDef, kTelemetryCount> kTelemetry = {{
-  {"HRG_WAVE_X",      0x100, 8, 500, "HRG", kWaveX},
-  {"HRG_WAVE_Y",      0x101, 8, 500, "HRG", kWaveY},
+  {"HRG_WAVE_X",      0x100, 8, 100, "HRG", kWaveX},
+  {"HRG_WAVE_Y",      0x101, 8, 100, "HRG", kWaveY},
   {"HRG_ANGLE",       0x102, 7, 500, "HRG", kAngle},
   {"HRG_LOOPS",       0x103, 8, 100, "HRG", kLoops},
   {"HRG_PUMP",        0x104, 7, 100, "HRG", kPump},
@@ -178,7 +198,11 @@ const std::array<MessageDef, kTelemetryCount> kTelemetry = {{
   {"HRG_EXEC",        0x109, 8,  10, "HRG", kExec},
   {"HRG_INFO",        0x10A, 8,   1, "HRG", kInfo},
   {"HRG_CAN_STATS",   0x10B, 8,   1, "HRG", kCanStats},
+  {"HRG_ROW",         0x10C, 8, 100, "HRG", kRow},
+  {"HRG_REFERENCE",   0x10D, 5,   1, "HRG", kReference},
 }};
+
+const MessageDef kLabTable = {"LAB_TABLE", kLabTableId, 7, 0, "LAB", kLabTableSignals};
 
 const std::array<MessageDef, kCommandCount> kCommands = {{
   {"HOST_SET_MODE",       0x080, 3, 0, "HOST", kSetMode},
@@ -202,7 +226,8 @@ const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages = {{
 
 static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoops, 8) &&
               fits(kPump, 7) && fits(kStatus, 7) && fits(kEstDamping, 8) && fits(kEstSplit, 7) &&
-              fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8));
+              fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8) &&
+              fits(kRow, 8) && fits(kReference, 5) && fits(kLabTableSignals, 7));
 static_assert(fits(kSetMode, 3) && fits(kIdent, 3) && fits(kWindow, 6) && fits(kAgc, 4) &&
               fits(kStatusRequest, 2) && fits(kReplySignals, 4));
 static_assert(fits(kCalSeedRequest, 1) && fits(kCalKey, 5) && fits(kCalStart, 7) &&
@@ -226,6 +251,7 @@ const MessageDef* find_message(uint32_t id) {
   if (id == kReply.id) return &kReply;
   for (const auto& m : kCalibrationMessages)
     if (m.id == id) return &m;
+  if (id == kLabTable.id) return &kLabTable;
   return nullptr;
 }
 

@@ -23,8 +23,9 @@ TelemetryConfig TelemetryConfig::defaults() {
 
 bool TelemetryConfig::valid(uint32_t base_rate_hz) const {
   // A recording row is one HRG_WAVE_X and the HRG_WAVE_Y of the same sample.
-  if (rate_hz[static_cast<std::size_t>(Tm::wave_x)] !=
-      rate_hz[static_cast<std::size_t>(Tm::wave_y)]) {
+  const uint16_t wave = rate_hz[static_cast<std::size_t>(Tm::wave_x)];
+  if (rate_hz[static_cast<std::size_t>(Tm::wave_y)] != wave ||
+      rate_hz[static_cast<std::size_t>(Tm::row)] != wave) {
     return false;
   }
   for (const auto r : rate_hz) {
@@ -116,10 +117,26 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::restarts, sat_u(s.can.restarts, 255), f);
       put(m, sig::can_state, static_cast<double>(static_cast<uint8_t>(s.can_state)), f);
       break;
+    case Tm::row:
+      put(m, sig::row_t_s, s.row_t_s, f);
+      put(m, sig::row_pump_v, s.pump_v, f);
+      put(m, sig::row_exc, b(s.row_exc), f);
+      break;
+    case Tm::reference: put(m, sig::f_ref_hz, s.f_ref_hz, f); break;
   }
   // Every telemetry message ends its table with `seq`.
   const SignalDef* seq_sig = find_signal(m, "seq");
   if (seq_sig != nullptr) put_bits(f, seq_sig->start_bit, seq_sig->length, seq);
+}
+
+hal::CanFrame encode_lab_table(double rate_dps, double temp_c, uint8_t seq) {
+  hal::CanFrame f;
+  f.id = kLabTable.id;
+  f.len = kLabTable.dlc;
+  put(kLabTable, sig::table_rate_dps, rate_dps, f);
+  put(kLabTable, sig::table_temp_c, temp_c, f);
+  put_bits(f, kLabTable.signals[sig::table_seq].start_bit, kSeqBits, seq);
+  return f;
 }
 
 TelemetryEncoder::TelemetryEncoder(const TelemetryConfig& config, uint32_t base_rate_hz)
@@ -134,8 +151,13 @@ std::size_t TelemetryEncoder::tick(const TelemetrySnapshot& s, std::span<hal::Ca
     if (rate == 0) continue;
     // An invalid base rate leaves rates above it: send those every frame.
     const uint64_t period = rate >= base_rate_hz_ ? 1 : base_rate_hz_ / rate;
-    // HRG_WAVE_Y goes out in the same frame as HRG_WAVE_X (same sample, same seq).
-    const std::size_t phase = i == static_cast<std::size_t>(Tm::wave_y) ? 0 : i;
+    // HRG_WAVE_Y and HRG_ROW go out in the same frame as HRG_WAVE_X (same
+    // row, same seq).
+    const bool row_part = i == static_cast<std::size_t>(Tm::wave_x) ||
+                          i == static_cast<std::size_t>(Tm::wave_y) ||
+                          i == static_cast<std::size_t>(Tm::row);
+    if (row_part && !s.row_ready) continue;
+    const std::size_t phase = row_part ? 0 : i;
     if ((frame_ + phase) % period != 0) continue;
     encode_now(static_cast<Tm>(i), s, out[n++]);
   }

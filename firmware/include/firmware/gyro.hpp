@@ -6,6 +6,7 @@
 
 #include "firmware/angle_output.hpp"
 #include "firmware/can/command.hpp"
+#include "firmware/can/envelope_reference.hpp"
 #include "firmware/can/link.hpp"
 #include "firmware/can/telemetry.hpp"
 #include "firmware/executive.hpp"
@@ -37,6 +38,9 @@ struct GyroConfig {
   double max_window_misfit = 4.0;
   WindowConfig windows{};
   MonitorConfig monitor{};
+  // How the telemetry's envelopes are referred and stamped (set from the
+  // chain and the converters by the firmware's configuration).
+  can::EnvelopeReferenceConfig envelope{};
 };
 
 // Everything the firmware reports once per frame (telemetry, recordings).
@@ -153,6 +157,7 @@ class Gyro {
   GyroStatus status_{};
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
+  can::EnvelopeReference envelope_;
   can::CanLink link_;
   ChainCommands commands_{};
   std::array<hal::q31_t, kBlockFrames * hal::kAdcChannels> adc_{};

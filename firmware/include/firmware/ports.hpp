@@ -26,7 +26,8 @@ struct ChainCommands {
 // the block's end on the board's clock. The estimator's samples, the output
 // and the telemetry are all read from this one record.
 struct ChainRecord : dsp::ChainOutputs {
-  double t_s = 0.0;  // time of the block end
+  double t_s = 0.0;        // time of the block end
+  uint32_t nco_phase = 0;  // NCO phase at that time (first sample after the block), 2^-32 cycles
 };
 
 // The DSP chain as the firmware sees it: once per ADC block, ADC block in, DAC

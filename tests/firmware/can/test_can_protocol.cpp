@@ -230,7 +230,7 @@ TEST(Telemetry, EachMessageIsSentAtItsRateWithARollingSequenceCounter) {
       ++count[i];
     }
   }
-  // THEN each message was sent rate_hz times: e.g. the wave 500 times, seq 499 % 256
+  // THEN each message was sent rate_hz times: e.g. the angle 500 times, seq 499 % 256
   for (std::size_t i = 0; i < kTelemetryCount; ++i) {
     LONGS_EQUAL(kTelemetry[i].default_rate_hz, count[i]);
     LONGS_EQUAL((kTelemetry[i].default_rate_hz - 1) % 256, last_seq[i]);
@@ -242,6 +242,7 @@ TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
   c.rate_hz[static_cast<std::size_t>(Tm::wave_x)] = 1000;
   c.rate_hz[static_cast<std::size_t>(Tm::angle)] = 0;  // off
   c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 1000;
+  c.rate_hz[static_cast<std::size_t>(Tm::row)] = 1000;
   TelemetryEncoder enc(c, 1000);
   CHECK(enc.config_ok());
   TelemetrySnapshot s;
@@ -262,6 +263,9 @@ TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
   c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 500;  // halves of a sample must pair
   CHECK_FALSE(c.valid(1000));
   c.rate_hz[static_cast<std::size_t>(Tm::wave_y)] = 1000;
+  c.rate_hz[static_cast<std::size_t>(Tm::row)] = 500;  // and the row that stamps them
+  CHECK_FALSE(c.valid(1000));
+  c.rate_hz[static_cast<std::size_t>(Tm::row)] = 1000;
   c.rate_hz[static_cast<std::size_t>(Tm::status)] = 3;  // 1000 / 3 is not whole
   CHECK_FALSE(c.valid(1000));
   TelemetryEncoder bad(c, 1000);
@@ -269,44 +273,58 @@ TEST(Telemetry, RatesAreConfigurableAndARateThatDoesNotDivideTheBaseIsRefused) {
   LONGS_EQUAL(10, bad.config().rate_hz[static_cast<std::size_t>(Tm::status)]);
 }
 
-TEST(Telemetry, BothHalvesOfAWaveSampleGoOutInTheSameFrameWithTheSameSeq) {
+TEST(Telemetry, TheThreePartsOfARecordingRowGoOutInTheSameFrameWithTheSameSeq) {
   TelemetryEncoder enc(TelemetryConfig::defaults(), 1000);
   TelemetrySnapshot s;
   std::array<CanFrame, kTelemetryCount> out;
-  int pairs = 0;
+  int rows = 0;
   for (int k = 0; k < 1000; ++k) {
     s.cx_v = 1e-3 * k;
     s.cy_v = -1e-3 * k;
+    s.row_t_s = 1e-3 * k;
+    // The first 20 frames have no envelope reference yet: nothing of a row.
+    s.row_ready = k >= 20;
     const std::size_t n = enc.tick(s, out);
     const CanFrame* x = nullptr;
     const CanFrame* y = nullptr;
+    const CanFrame* r = nullptr;
     for (std::size_t j = 0; j < n; ++j) {
       if (out[j].id == telemetry_def(Tm::wave_x).id) x = &out[j];
       if (out[j].id == telemetry_def(Tm::wave_y).id) y = &out[j];
+      if (out[j].id == telemetry_def(Tm::row).id) r = &out[j];
     }
     CHECK((x == nullptr) == (y == nullptr));
+    CHECK((x == nullptr) == (r == nullptr));
     if (x == nullptr) continue;
-    ++pairs;
+    CHECK(k >= 20);
+    ++rows;
     const MessageDef& mx = telemetry_def(Tm::wave_x);
     const MessageDef& my = telemetry_def(Tm::wave_y);
-    LONGS_EQUAL(decode_raw(mx.signals[sig::wave_x_seq], *x),
-                decode_raw(my.signals[sig::wave_y_seq], *y));
+    const MessageDef& mr = telemetry_def(Tm::row);
+    const auto seq = decode_raw(mx.signals[sig::wave_x_seq], *x);
+    LONGS_EQUAL(seq, decode_raw(my.signals[sig::wave_y_seq], *y));
+    LONGS_EQUAL(seq, decode_raw(mr.signals[sig::row_seq], *r));
     DOUBLES_EQUAL(-decode_signal(mx.signals[sig::cx_v], *x),
                   decode_signal(my.signals[sig::cy_v], *y), 1e-9);
+    DOUBLES_EQUAL(decode_signal(mx.signals[sig::cx_v], *x),
+                  decode_signal(mr.signals[sig::row_t_s], *r), 1e-9);
   }
-  LONGS_EQUAL(500, pairs);
+  // 100 Hz from frame 20 on (the encoder's period does not restart).
+  LONGS_EQUAL(98, rows);
 }
 
 TEST(Telemetry, DefaultBusLoadIsTheSumOfRateTimesWorstCaseFrameBits) {
   // 8 data bytes: 47 + 64 + floor(97 / 4) = 135 bits; 7 bytes: 47 + 56 + 22 = 125 bits.
   LONGS_EQUAL(135, worst_case_frame_bits(8));
   LONGS_EQUAL(125, worst_case_frame_bits(7));
-  // wave x, y (8 B) and angle (7 B) at 500 Hz; loops (8 B) and pump (7 B) at 100 Hz;
-  // status (7 B) and exec (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info, can stats (8 B) at 1 Hz.
-  const double bits = 500.0 * (135 + 135 + 125) + 100.0 * (135 + 125) + 10.0 * (125 + 135) +
-                      2.0 * (135 + 125 + 135) + 1.0 * (135 + 135);
+  LONGS_EQUAL(105, worst_case_frame_bits(5));
+  // angle (7 B) at 500 Hz; wave x, y, row and loops (8 B), pump (7 B) at 100 Hz;
+  // status (7 B) and exec (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info, can stats (8 B)
+  // and reference (5 B) at 1 Hz.
+  const double bits = 500.0 * 125 + 100.0 * (135 + 135 + 135 + 135 + 125) + 10.0 * (125 + 135) +
+                      2.0 * (135 + 125 + 135) + 1.0 * (135 + 135 + 105);
   const double load = bus_load_fraction(TelemetryConfig::defaults(), kBitrateBps);
   DOUBLES_EQUAL(bits / 1e6, load, 1e-12);
-  DOUBLES_EQUAL(0.22716, load, 1e-6);
+  DOUBLES_EQUAL(0.132765, load, 1e-6);
   CHECK(load < 0.5);
 }

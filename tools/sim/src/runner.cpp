@@ -120,6 +120,15 @@ void track_events(const fw::Gyro& gyro, sim::SimTarget& target, fw::Mode& last_m
   }
 }
 
+// The bench's rate table and chamber on the bus: a LAB_TABLE frame with the
+// input rate and temperature a recording row's envelope saw, logged in the
+// frame the firmware queues that row. The bus sends the row one frame later,
+// so a reader pairs each row with the latest LAB_TABLE before it.
+struct LabTable {
+  uint64_t period_frames = 1;  // the firmware's recording row period
+  uint8_t seq = 0;
+};
+
 // Counts (and logs, when asked) the frames the firmware put on the bus.
 void drain_can(sim::SimTarget& target, can::CandumpLogWriter* log, double t_s, JobResult& r) {
   auto& bus = target.can();
@@ -331,6 +340,10 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   fw::Mode last_mode = fw::Mode::power_up;
   RowStamper stamp(job);
   AngleReference ref;
+  LabTable lab;
+  lab.period_frames =
+      fw::kBaseRateHz /
+      fw::can::TelemetryConfig::defaults().rate_hz[static_cast<std::size_t>(fw::can::Tm::row)];
   for (uint64_t k = 0; k < frames; ++k) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
@@ -338,6 +351,11 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     stamp.after_block(*firmware, target);
     track_events(gyro, target, last_mode, r);
     drain_can(target, log.get(), st.chain.t_s, r);
+    if (log && stamp.history_full() && k % lab.period_frames == 0) {
+      const sim::TrueState ts = stamp.truth();
+      log->write(fw::can::encode_lab_table(ts.rate_rad_s / kDeg, ts.temp_c, lab.seq++),
+                 static_cast<uint64_t>(st.chain.t_s * 1e9));
+    }
     if (k % row_every != 0 || !stamp.history_full()) continue;
     if (!ref.set && st.out_valid) {
       ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};

@@ -42,7 +42,12 @@ void apply_window_plan(WindowConfig& w, WindowPlan plan);
 
 // Fills the derived fields: the chain's converter fields from `conv`, and K
 // and the set point from `cfg.gyro` into the chain, the estimator and the
-// monitor.
+// monitor, and the telemetry's envelope reference from the chain.
 void derive(FirmwareConfig& cfg, const ConverterLayout& conv);
+
+// The telemetry's fixed reference (the chain's centre frequency), the
+// envelope's centre and the blocks until a row is free of the drive.
+can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& chain,
+                                                       const ConverterLayout& conv);
 
 }  // namespace hrg::fw::app

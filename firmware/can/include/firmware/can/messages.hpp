@@ -14,12 +14,14 @@ namespace hrg::fw::can {
 // the DBC and checks that every message and signal below agrees with it.
 //
 // Identifiers: host commands 0x080-0x08F (highest priority), the command reply
-// 0x090, telemetry 0x100-0x10B. Every telemetry message and the reply carry a
+// 0x090, the calibration service 0x0A0-0x0A8, the test bench's LAB_TABLE 0x0C0,
+// telemetry 0x100-0x10D. Every telemetry message and the reply carry a
 // rolling 8-bit `seq` that increments per message sent, so a reader counts
 // losses per message. Commands carry a 4-bit `counter` and a CRC-8 (see
 // command.hpp).
 
-inline constexpr uint8_t kProtocolVersion = 1;
+// 2: HRG_WAVE_X/Y against the fixed reference of HRG_REFERENCE, HRG_ROW.
+inline constexpr uint8_t kProtocolVersion = 2;
 inline constexpr uint32_t kBitrateBps = 1'000'000;
 
 // Telemetry messages, in table order (index into kTelemetry).
@@ -36,8 +38,10 @@ enum class Tm : uint8_t {
   exec,
   info,
   can_stats,
+  row,
+  reference,
 };
-inline constexpr std::size_t kTelemetryCount = 12;
+inline constexpr std::size_t kTelemetryCount = 14;
 
 // Host commands, in table order (index into kCommands); id = 0x080 + index.
 enum class Cmd : uint8_t { set_mode, ident, window, agc, status_request };
@@ -54,6 +58,11 @@ inline constexpr std::size_t kCalibrationMessageCount = 6;
 extern const std::array<MessageDef, kTelemetryCount> kTelemetry;
 extern const std::array<MessageDef, kCommandCount> kCommands;
 extern const MessageDef kReply;
+// LAB_TABLE: the rate table's input rate and the chamber's temperature as the
+// test bench puts them on the bus (`hrg sim --can-log` writes one per
+// recording row); the gyro neither sends nor reads it, `hrg can-decode` does.
+inline constexpr uint32_t kLabTableId = 0x0C0;
+extern const MessageDef kLabTable;
 extern const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages;
 
 constexpr const MessageDef& telemetry_def(Tm m) { return kTelemetry[static_cast<std::size_t>(m)]; }
@@ -94,6 +103,9 @@ enum CanStats : uint8_t {
   can_state,
   can_stats_seq
 };
+enum Row : uint8_t { row_t_s, row_pump_v, row_seq, row_exc };
+enum Reference : uint8_t { f_ref_hz, reference_seq };
+enum LabTable : uint8_t { table_rate_dps, table_temp_c, table_seq };
 enum SetMode : uint8_t { target_mode, set_mode_counter, set_mode_crc };
 enum Ident : uint8_t { action, ident_counter, ident_crc };
 enum Window : uint8_t { period_s, length_s, window_counter, window_crc };

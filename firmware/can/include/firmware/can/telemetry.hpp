@@ -16,8 +16,14 @@ namespace hrg::fw::can {
 // base frame. Values outside a signal's range saturate on the bus; counters
 // saturate at their field width.
 struct TelemetrySnapshot {
-  // Demodulated pickoffs (physics.md section 3).
+  // Demodulated pickoffs (physics.md section 3) against the fixed reference
+  // f_ref_hz at the row time row_t_s (EnvelopeReference): what an
+  // hrg-recording holds, so the decoded log needs no phase of ours.
   double cx_v = 0, sx_v = 0, cy_v = 0, sy_v = 0;
+  double row_t_s = 0;           // time of the envelope (centre of the demodulator's window)
+  bool row_exc = true;          // a drive acted inside the envelope's window (DAC latency included)
+  bool row_ready = true;        // false: the envelope has no reference yet (wave and row held back)
+  double f_ref_hz = 0;          // the fixed demodulation reference of the recording
   double theta_a_rad = 0;       // pattern angle, (-pi/4, pi/4] or unwrapped
   double output_angle_rad = 0;  // gyro output angle, -2 (theta_A - theta_A0) / K
   double pll_freq_hz = 0;
@@ -62,7 +68,7 @@ struct TelemetryConfig {
   std::array<uint16_t, kTelemetryCount> rate_hz{};
   static TelemetryConfig defaults();
   // True when every rate is 0 or divides base_rate_hz, and the two wave
-  // messages (the halves of one sample) have the same rate.
+  // messages and HRG_ROW (the parts of one recording row) have the same rate.
   bool valid(uint32_t base_rate_hz) const;
 };
 
@@ -71,6 +77,10 @@ double bus_load_fraction(const TelemetryConfig& config, uint32_t bitrate_bps);
 
 // Encodes one telemetry message from the snapshot with the given sequence value.
 void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::CanFrame& out);
+
+// The test bench's LAB_TABLE frame (input rate, temperature): written by the
+// simulator's runner for its rate table, and by tests.
+hal::CanFrame encode_lab_table(double rate_dps, double temp_c, uint8_t seq);
 
 // Emits the telemetry due in each base frame, with per-message sequence counters.
 // Calling context: the executive's telemetry task, once per base frame. No heap.
@@ -83,7 +93,8 @@ class TelemetryEncoder {
   // Writes the frames due in this base frame into `out` (at most
   // kTelemetryCount) and returns how many. Messages are staggered (message i is
   // sent when (frame + i) is a multiple of its period) to spread the load;
-  // HRG_WAVE_Y always goes with HRG_WAVE_X.
+  // HRG_WAVE_Y and HRG_ROW always go with HRG_WAVE_X, and none of the three
+  // while the snapshot's row is not ready.
   std::size_t tick(const TelemetrySnapshot& s, std::span<hal::CanFrame> out);
   // Encodes one message now (e.g. STATUS on request), advancing its counter.
   void encode_now(Tm message, const TelemetrySnapshot& s, hal::CanFrame& out);
