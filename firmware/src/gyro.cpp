@@ -18,7 +18,7 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, ResonatorIdentifier& identifie
       scheduler_(cfg.windows),
       output_(cfg.angular_gain, 1.0 / kBaseRateHz),
       envelope_(cfg.envelope),
-      link_(board.can, kCanRestartRuns) {
+      link_(board.can, kCanRestartRuns, cfg.calibration_service) {
   monitor_.set_amplitude_set_v(cfg_.amplitude_set_v);
   const hal::ConverterInfo adc = board.adc.info();
   const hal::ConverterInfo dac = board.dac.info();
@@ -346,6 +346,9 @@ void Gyro::task_commands(Gyro& g) {
   const bool bus_off = g.board_.can.state() == hal::CanState::bus_off;
   g.link_.service();
   if (bus_off) return;
+  // The calibration service's clock: milliseconds of base frames.
+  const auto now_ms = static_cast<uint32_t>(g.exec_.frame_stats().frames * 1000u / kBaseRateHz);
+  g.link_.tick_calibration(now_ms, g.mode_.mode());
   can::ControllerView view;
   view.faults = static_cast<uint16_t>(g.status_.faults | g.mode_.faults());
   view.fault_input = g.status_.fault_input;
@@ -355,7 +358,9 @@ void Gyro::task_commands(Gyro& g) {
     view.mode = g.mode_.mode();
     view.agc_setpoint_v = g.cfg_.amplitude_set_v;
     can::Command cmd;
-    if (!g.link_.poll(view, cmd)) break;  // refused ones are answered by the link
+    // Refused commands and every calibration frame are answered by the link;
+    // a calibration block is applied there (service mode, between blocks).
+    if (!g.link_.poll(view, cmd, now_ms, static_cast<uint32_t>(g.exec_timer_.now_ns()))) break;
     g.apply(cmd);
     if (cmd.id == can::Cmd::status_request) {
       hal::CanFrame status;

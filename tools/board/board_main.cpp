@@ -3,14 +3,20 @@
 // simulated converters of sim_target behind the ADC/DAC seam (no hardware
 // needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
-//             [--calibration FILE]
+//             [--calibration FILE] [--cal-secret HEX]
 // The firmware sends its telemetry on IF at the default rates, answers the
 // commands of the DBC and restarts the controller after 100 ms of bus-off, all
 // through its own CAN link (receive filter set at start). Runs until
 // SIGTERM/SIGINT or S seconds. --calibration FILE (hrg audit --calibration)
-// puts that calibration in force from the start.
+// puts that calibration in force from the start; --cal-secret HEX (32 hex
+// digits) is the gyro's secret for the guarded write over CAN
+// (hrg can-calibrate), all zero when not given. As the bench behind the
+// simulated converters, it puts the simulated input rate and temperature on
+// the bus (LAB_TABLE, one per recording row), so a candump of IF decodes into
+// an audit-grade recording (hrg can-decode).
 #include <signal.h>
 
+#include <array>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -18,8 +24,10 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <numbers>
 #include <string>
 
+#include "can/calibration_sender.hpp"
 #include "firmware/app/firmware.hpp"
 #include "firmware/calibration_file.hpp"
 #include "hal/linux/gpiod_line.hpp"
@@ -44,12 +52,13 @@ struct Options {
   unsigned fault_line = 1;
   double seconds = 1e9;
   std::string calibration;  // empty: the identity
+  fw::can::CalSecret cal_secret{};
 };
 
 int usage() {
   std::fprintf(stderr,
                "usage: hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] "
-               "[--seconds S] [--calibration FILE]\n");
+               "[--seconds S] [--calibration FILE] [--cal-secret HEX]\n");
   return 2;
 }
 
@@ -70,12 +79,48 @@ bool parse(int argc, char** argv, Options& o) {
       o.seconds = std::atof(v);
     } else if (a == "--calibration") {
       o.calibration = v;
+    } else if (a == "--cal-secret") {
+      if (!can::parse_secret(v, o.cal_secret)) return false;
     } else {
       return false;
     }
   }
   return true;
 }
+
+// The bench behind the simulated converters: the input rate and temperature
+// the firmware's next recording row will have seen (the centre of its
+// demodulator window, kCentre blocks and a half back), sent as LAB_TABLE just
+// before the firmware sends that row, so a reader pairs each row with the
+// latest LAB_TABLE before it.
+class LabTable {
+ public:
+  explicit LabTable(const sim::SimTarget& sim) {
+    for (auto& s : hist_)
+      s = sim.true_state();
+    period_ =
+        fw::kBaseRateHz /
+        fw::can::TelemetryConfig::defaults().rate_hz[static_cast<std::size_t>(fw::can::Tm::row)];
+  }
+  void before_frame(uint64_t k, hal::CanBus& can) {
+    if (k < hist_.size() || k % period_ != 0) return;
+    // After block k - 1, the window of frame k's row is centred between the
+    // ends of blocks k - 3 and k - 2.
+    const double rate_dps = 0.5 * (hist_[1].rate_rad_s + hist_[2].rate_rad_s) * 180.0 / std::numbers::pi;
+    const double temp_c = 0.5 * (hist_[1].temp_c + hist_[2].temp_c);
+    (void)can.send(fw::can::encode_lab_table(rate_dps, temp_c, seq_++));
+  }
+  void after_frame(const sim::SimTarget& sim) {
+    for (std::size_t i = hist_.size() - 1; i > 0; --i)
+      hist_[i] = hist_[i - 1];
+    hist_[0] = sim.true_state();
+  }
+
+ private:
+  std::array<sim::TrueState, 4> hist_{};
+  uint64_t period_ = 10;
+  uint8_t seq_ = 0;
+};
 
 }  // namespace
 
@@ -84,6 +129,7 @@ int main(int argc, char** argv) {
   if (!parse(argc, argv, o)) return usage();
 
   simtools::JobConfig job = simtools::default_job(o.seconds > 3600 ? 3600 : o.seconds, 0);
+  job.firmware.gyro.calibration_service.secret = o.cal_secret;
   if (!o.calibration.empty()) {
     try {
       job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
@@ -142,8 +188,11 @@ int main(int argc, char** argv) {
   uint64_t k = 0;
   int exc_edges = 0;
   bool last_exc = false;
+  LabTable lab(sim);
   for (; k < frames && g_stop == 0; ++k) {
+    lab.before_frame(k, can);
     gyro->run_frame();
+    lab.after_frame(sim);
     const fw::GyroStatus& st = gyro->status();
     if (st.enable_line != last_exc) ++exc_edges;
     last_exc = st.enable_line;

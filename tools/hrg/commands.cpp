@@ -4,6 +4,7 @@
 #include <array>
 
 #include "audit/audit_command.hpp"
+#include "can/calibration_sender.hpp"
 #include "can/can_decode.hpp"
 #include "hrg/sim_command.hpp"
 
@@ -14,7 +15,7 @@ int characterize_main(std::span<char* const> args);       // characterize_comman
 int calibration_check_main(std::span<char* const> args);  // calibration_check_command.cpp
 
 namespace {
-constexpr std::array<Command, 7> kCommands{{
+constexpr std::array<Command, 8> kCommands{{
     {"sim", "run the firmware against the simulated gyro (the main job)", &sim_main},
     {"audit", "locate sim/recording mismatches and name the left-out physics",
      &hrg::audit::audit_main},
@@ -24,6 +25,8 @@ constexpr std::array<Command, 7> kCommands{{
      &hrg::audit::audit_bench_main},
     {"can-decode", "turn a candump log of the CAN telemetry into an hrg-recording v1",
      &hrg::can::can_decode_main},
+    {"can-calibrate", "write a calibration file into a gyro over CAN (guarded write)",
+     &hrg::can::can_calibrate_main},
     {"scenario-check", "validate simulator scenario files (TOML)", &scenario_check_main},
     {"calibration-check", "validate a calibration file (TOML); write it as a C++ constant",
      &calibration_check_main},

@@ -57,7 +57,7 @@ const char* to_string(CalResult r) {
   static constexpr const char* kNames[kCalResultCount] = {
       "accepted",     "bad_length", "bad_checksum", "wrong_state", "locked",
       "bad_key",      "locked_out", "bad_sequence", "stale",       "crc_mismatch",
-      "out_of_range", "bad_format", "incomplete"};
+      "out_of_range", "bad_format", "incomplete",   "not_applied"};
   const auto i = static_cast<std::size_t>(r);
   return i < kCalResultCount ? kNames[i] : "unknown";
 }
@@ -99,6 +99,11 @@ CalibrationTransfer::CalibrationTransfer(const CalTransferConfig& cfg, const Cal
       active_(active),
       active_crc_(calibration_crc(active)),
       attempts_left_(cfg.max_attempts) {}
+
+void CalibrationTransfer::set_active(const Calibration& active) {
+  active_ = active;
+  active_crc_ = calibration_crc(active);
+}
 
 CalTransferOutcome CalibrationTransfer::answer(CalStep step, CalResult r, uint8_t detail,
                                                uint32_t value) {
@@ -264,6 +269,9 @@ CalTransferOutcome CalibrationTransfer::on_end(uint32_t now_ms) {
   if (!deserialize(block, c)) return answer(CalStep::end, CalResult::bad_format, block[0]);
   const int bad = first_out_of_range(c);
   if (bad >= 0) return answer(CalStep::end, CalResult::out_of_range, static_cast<uint8_t>(bad));
+  if (apply_ != nullptr && !apply_(apply_context_, c)) {
+    return answer(CalStep::end, CalResult::not_applied, 0, active_crc_);
+  }
   active_ = c;
   active_crc_ = want_crc;
   ++applied_;

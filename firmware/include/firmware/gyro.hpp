@@ -41,6 +41,8 @@ struct GyroConfig {
   // How the telemetry's envelopes are referred and stamped (set from the
   // chain and the converters by the firmware's configuration).
   can::EnvelopeReferenceConfig envelope{};
+  // The guarded calibration write over CAN (the secret is this gyro's).
+  can::CalTransferConfig calibration_service{};
 };
 
 // Everything the firmware reports once per frame (telemetry, recordings).
@@ -120,8 +122,16 @@ class Gyro {
   uint32_t can_tx_refused() const { return link_.stats().tx_refused; }
   // CAN controller restarts made after bus-off.
   uint32_t can_restarts() const { return link_.stats().restarts; }
-  // The firmware's CAN link (commands, telemetry, bus-off restart).
+  // The firmware's CAN link (commands, telemetry, bus-off restart, the
+  // calibration service).
   const can::CanLink& can_link() const { return link_; }
+  // Where a calibration written over CAN goes (the firmware's apply path,
+  // all or nothing), and the one in force now.
+  void set_calibration_apply(can::CalibrationApply apply_fn, void* context,
+                             const Calibration& active) {
+    link_.calibration().set_apply(apply_fn, context);
+    link_.calibration().set_active(active);
+  }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);

@@ -318,3 +318,33 @@ TEST(CalibrationTransfer, CrcFormatAndRangeAreCheckedBeforeAnythingIsApplied) {
   CHECK_EQUAL(kAccepted, result_of(rig.write(serialize(c), crc)));
   CHECK_EQUAL(crc, rig.gyro.active_crc());
 }
+
+TEST(CalibrationTransfer, ABlockTheFirmwareCannotPutInForceIsRefusedAndChangesNothing) {
+  // The apply hook is the firmware's one apply path: when it refuses (the
+  // chain's formats cannot hold the correction) the transfer does too.
+  Rig rig;
+  int calls = 0;
+  struct Ctx {
+    int* calls;
+    bool accept;
+  } ctx{&calls, false};
+  rig.gyro.set_apply(
+      [](void* p, const Calibration&) {
+        auto* c = static_cast<Ctx*>(p);
+        ++*c->calls;
+        return c->accept;
+      },
+      &ctx);
+  const Calibration c = new_calibration();
+  rig.unlock();
+  const CalReply r = rig.write(serialize(c), calibration_crc(c));
+  CHECK_EQUAL(static_cast<int>(CalResult::not_applied), result_of(r));
+  CHECK_EQUAL(calibration_crc(kIdentityCalibration), r.value);  // still the one in force
+  CHECK_EQUAL(1, calls);
+  rig.expect_unchanged();
+  ctx.accept = true;
+  rig.unlock();
+  CHECK_EQUAL(kAccepted, result_of(rig.write(serialize(c), calibration_crc(c))));
+  CHECK_EQUAL(2, calls);
+  CHECK_EQUAL(calibration_crc(c), rig.gyro.active_crc());
+}

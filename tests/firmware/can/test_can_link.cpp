@@ -62,11 +62,34 @@ TEST_GROUP(CanLink) {
   }
 };
 
-TEST(CanLink, InitAcceptsOnlyTheCommandRange) {
+TEST(CanLink, InitAcceptsOnlyTheCommandRangeAndTheCalibrationService) {
   CHECK(Status::ok == link.init());
-  LONGS_EQUAL(1, bus.filters().size());
+  LONGS_EQUAL(2, bus.filters().size());
   LONGS_EQUAL(0x080, bus.filters()[0].id);
   LONGS_EQUAL(0x7F0, bus.filters()[0].mask);
+  LONGS_EQUAL(0x0A0, bus.filters()[1].id);
+  LONGS_EQUAL(0x7F8, bus.filters()[1].mask);
+}
+
+TEST(CanLink, CalibrationFramesGoToTheTransferAndAreAnsweredNotReturnedAsCommands) {
+  // A seed request in the service mode: answered with a seed, no command.
+  ControllerView safe;
+  safe.mode = Mode::safe;
+  bus.inject(encode_cal_seed_request());
+  Command c;
+  CHECK_FALSE(link.poll(safe, c, 1000, 77));
+  CalReply r;
+  CHECK(decode_cal_reply(bus.last(), r));
+  CHECK(CalStep::seed == r.step);
+  CHECK(CalResult::accepted == r.result);
+  CHECK(r.value != 0);
+  CHECK(link.calibration().unlocked() == false);
+  // While operating the same request is refused, still answered by the link.
+  bus.inject(encode_cal_seed_request());
+  CHECK_FALSE(link.poll(operating(), c, 1001, 78));
+  CHECK(decode_cal_reply(bus.last(), r));
+  CHECK(CalResult::wrong_state == r.result);
+  LONGS_EQUAL(0, link.stats().commands_accepted + link.stats().commands_refused);
 }
 
 TEST(CanLink, AnAcceptedCommandIsReturnedAndAnswered) {

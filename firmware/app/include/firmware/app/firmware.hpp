@@ -25,6 +25,8 @@ class Firmware {
         estimator_(cfg.estimator),
         gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {
     calibration_ok_ = apply_calibration(cfg.calibration);
+    // A calibration written over CAN takes the same path.
+    gyro_.set_calibration_apply(&Firmware::apply_from_can, this, cfg_.calibration);
   }
   Firmware(const Firmware&) = delete;
   Firmware& operator=(const Firmware&) = delete;
@@ -59,6 +61,10 @@ class Firmware {
   EstimatorPort estimator_;
   Gyro gyro_;
   bool calibration_ok_ = true;
+
+  static bool apply_from_can(void* self, const Calibration& cal) {
+    return static_cast<Firmware*>(self)->apply_calibration(cal);
+  }
 };
 
 }  // namespace hrg::fw::app

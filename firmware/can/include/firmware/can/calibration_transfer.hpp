@@ -52,8 +52,9 @@ enum class CalResult : uint8_t {
   out_of_range = 10,  // detail = index of the first field out of range (kCalibrationFields)
   bad_format = 11,    // format version byte unknown
   incomplete = 12,    // END before all bytes arrived; detail = bytes received
+  not_applied = 13,   // valid, but the firmware could not put it in force (the chain's formats)
 };
-inline constexpr std::size_t kCalResultCount = 13;
+inline constexpr std::size_t kCalResultCount = 14;
 const char* to_string(CalResult r);
 
 // Which frame a reply answers (HRG_CAL_REPLY.step).
@@ -83,9 +84,22 @@ struct CalTransferOutcome {
   hal::CanFrame reply{};
 };
 
+// Puts a checked calibration in force, all or nothing (false: the one in
+// force stays). The firmware's one apply path, called at END from the
+// command task: in the service mode, between two blocks of the chain.
+using CalibrationApply = bool (*)(void* context, const Calibration& cal);
+
 class CalibrationTransfer {
  public:
   CalibrationTransfer(const CalTransferConfig& cfg, const Calibration& active);
+
+  // Where an accepted block goes (none: it only becomes active()), and the
+  // calibration in force now (its CRC answers END).
+  void set_apply(CalibrationApply apply, void* context) {
+    apply_ = apply;
+    apply_context_ = context;
+  }
+  void set_active(const Calibration& active);
 
   static bool is_calibration_id(uint32_t id) { return id >= kCalSeedRequestId && id <= kCalEndId; }
 
@@ -118,6 +132,8 @@ class CalibrationTransfer {
   bool locked_out(uint32_t now_ms) const;
 
   CalTransferConfig cfg_;
+  CalibrationApply apply_ = nullptr;
+  void* apply_context_ = nullptr;
   Calibration active_;
   uint32_t active_crc_ = 0;
   State state_ = State::idle;
