@@ -3,7 +3,7 @@
 // simulated converters of sim_target behind the ADC/DAC seam (no hardware
 // needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
-//             [--calibration FILE] [--cal-secret HEX]
+//             [--calibration FILE] [--cal-secret HEX] [--lockstep]
 // The firmware sends its telemetry on IF at the default rates, answers the
 // commands of the DBC and restarts the controller after 100 ms of bus-off, all
 // through its own CAN link (receive filter set at start). Runs until
@@ -13,7 +13,10 @@
 // (hrg can-calibrate), all zero when not given. As the bench behind the
 // simulated converters, it puts the simulated input rate and temperature on
 // the bus (LAB_TABLE, one per recording row), so a candump of IF decodes into
-// an audit-grade recording (hrg can-decode).
+// an audit-grade recording (hrg can-decode). --lockstep paces the firmware by
+// the simulated converters instead of CLOCK_MONOTONIC (an emulator or a slow
+// machine: nothing is missed, the bus carries the same frames sooner; the
+// recording's time is the firmware's, HRG_ROW.t_s).
 #include <signal.h>
 
 #include <array>
@@ -53,18 +56,23 @@ struct Options {
   double seconds = 1e9;
   std::string calibration;  // empty: the identity
   fw::can::CalSecret cal_secret{};
+  bool lockstep = false;
 };
 
 int usage() {
   std::fprintf(stderr,
                "usage: hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] "
-               "[--seconds S] [--calibration FILE] [--cal-secret HEX]\n");
+               "[--seconds S] [--calibration FILE] [--cal-secret HEX] [--lockstep]\n");
   return 2;
 }
 
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--lockstep") {
+      o.lockstep = true;
+      continue;
+    }
     if (i + 1 >= argc) return false;
     const char* v = argv[++i];
     if (a == "--can") {
@@ -106,7 +114,8 @@ class LabTable {
     if (k < hist_.size() || k % period_ != 0) return;
     // After block k - 1, the window of frame k's row is centred between the
     // ends of blocks k - 3 and k - 2.
-    const double rate_dps = 0.5 * (hist_[1].rate_rad_s + hist_[2].rate_rad_s) * 180.0 / std::numbers::pi;
+    const double rate_dps =
+        0.5 * (hist_[1].rate_rad_s + hist_[2].rate_rad_s) * 180.0 / std::numbers::pi;
     const double temp_c = 0.5 * (hist_[1].temp_c + hist_[2].temp_c);
     (void)can.send(fw::can::encode_lab_table(rate_dps, temp_c, seq_++));
   }
@@ -168,13 +177,17 @@ int main(int argc, char** argv) {
     fault = &fault_line;
   }
   lb::LinuxClock clock;
-  hal::Board board{sim_board.adc, sim_board.dac, *exc, *fault, can, clock};
+  // In lockstep the simulated converters' clock paces, the host's times the tasks.
+  hal::Board board{sim_board.adc, sim_board.dac, *exc,
+                   *fault,        can,           o.lockstep ? sim_board.clock : clock};
 
-  char rt[200];
-  std::printf("hrg-board: %s\n", lb::describe(lb::setup_realtime({}), rt, sizeof rt));
+  if (!o.lockstep) {
+    char rt[200];
+    std::printf("hrg-board: %s\n", lb::describe(lb::setup_realtime({}), rt, sizeof rt));
+  }
   // Large (the chain holds its filters): allocated once, before the loop.
-  auto firmware =
-      std::make_unique<fw::app::Firmware>(board, clock, fw::Pacing::real_time, job.firmware);
+  auto firmware = std::make_unique<fw::app::Firmware>(
+      board, clock, o.lockstep ? fw::Pacing::lockstep : fw::Pacing::real_time, job.firmware);
   if (const char* err = firmware->error()) {
     std::fprintf(stderr, "hrg-board: %s\n", err);
     return 1;

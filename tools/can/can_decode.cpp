@@ -226,14 +226,49 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
   return sum;
 }
 
+// What a decode found: rows, losses per message, frames left aside, the bus load.
+void print_summary(const CanDecodeOptions& o, const CanDecodeSummary& s) {
+  std::printf("can-decode: %llu frames, %llu rows -> %s (f_ref %.5f Hz, K %.5f)\n",
+              static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(s.rows),
+              o.out_path.c_str(), s.f_ref_hz, s.angular_gain);
+  uint64_t lost = 0;
+  for (const auto& [name, ml] : s.messages) {
+    lost += ml.lost;
+    if (ml.lost > 0) {
+      std::printf("can-decode: %-16s %llu of %llu frames lost\n", name.c_str(),
+                  static_cast<unsigned long long>(ml.lost),
+                  static_cast<unsigned long long>(ml.frames + ml.lost));
+    }
+  }
+  if (lost == 0) std::printf("can-decode: no frame lost\n");
+  if (s.span_s > 0 && s.bitrate_bps > 0) {
+    const double bps = s.bus_bits / s.span_s;
+    std::printf(
+        "can-decode: bus load %.2f %% of %u bit/s (%.0f bit/s at worst-case stuffing "
+        "over %.1f s)\n",
+        100.0 * bps / s.bitrate_bps, s.bitrate_bps, bps, s.span_s);
+  }
+  if (s.unpaired_wave > 0) {
+    std::printf("can-decode: %llu wave frames without their pair (no row)\n",
+                static_cast<unsigned long long>(s.unpaired_wave));
+  }
+  if (s.unknown_frames > 0) {
+    std::printf("can-decode: %llu frames not in the DBC ignored\n",
+                static_cast<unsigned long long>(s.unknown_frames));
+  }
+}
+
 int can_decode_main(std::span<char* const> args) {
   CanDecodeOptions o;
   auto usage = [] {
-    std::fprintf(stderr,
-                 "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
-                 "[--f-ref-hz F]\n"
-                 "Turns a candump -l log of HRG telemetry into an hrg-recording v1 and reports\n"
-                 "the frames lost (from each message's sequence counter).\n");
+    std::fprintf(
+        stderr,
+        "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
+        "[--f-ref-hz F]\n"
+        "Turns a candump -l log of HRG telemetry (protocol 2) into an hrg-recording v1\n"
+        "that hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s,\n"
+        "the drive as applied, rate and temperature from the bench's LAB_TABLE), and\n"
+        "reports the frames lost (from each message's sequence counter) and the bus load.\n");
     return 2;
   };
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -259,35 +294,7 @@ int can_decode_main(std::span<char* const> args) {
   }
   if (o.log_path.empty() || o.out_path.empty()) return usage();
   try {
-    const CanDecodeSummary s = can_decode(o);
-    std::printf("can-decode: %llu frames, %llu rows -> %s (f_ref %.5f Hz, K %.5f)\n",
-                static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(s.rows),
-                o.out_path.c_str(), s.f_ref_hz, s.angular_gain);
-    uint64_t lost = 0;
-    for (const auto& [name, ml] : s.messages) {
-      lost += ml.lost;
-      if (ml.lost > 0) {
-        std::printf("can-decode: %-16s %llu of %llu frames lost\n", name.c_str(),
-                    static_cast<unsigned long long>(ml.lost),
-                    static_cast<unsigned long long>(ml.frames + ml.lost));
-      }
-    }
-    if (lost == 0) std::printf("can-decode: no frame lost\n");
-    if (s.span_s > 0 && s.bitrate_bps > 0) {
-      const double bps = s.bus_bits / s.span_s;
-      std::printf(
-          "can-decode: bus load %.2f %% of %u bit/s (%.0f bit/s at worst-case stuffing "
-          "over %.1f s)\n",
-          100.0 * bps / s.bitrate_bps, s.bitrate_bps, bps, s.span_s);
-    }
-    if (s.unpaired_wave > 0) {
-      std::printf("can-decode: %llu wave frames without their pair (no row)\n",
-                  static_cast<unsigned long long>(s.unpaired_wave));
-    }
-    if (s.unknown_frames > 0) {
-      std::printf("can-decode: %llu frames not in the DBC ignored\n",
-                  static_cast<unsigned long long>(s.unknown_frames));
-    }
+    print_summary(o, can_decode(o));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg can-decode: %s\n", e.what());
     return 1;

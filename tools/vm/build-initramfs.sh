@@ -3,7 +3,8 @@
 # Builds the test VM's initramfs: static busybox, the kernel modules the tests
 # need (vcan, can-raw, configfs, sch_tbf and their dependencies, plus the
 # out-of-tree gpio-sim), can-utils, iproute2, the test binaries and every
-# shared library they load, and tools/vm/guest-init.sh as /init.
+# shared library they load, the DBC (/etc/hrg.dbc), and tools/vm/guest-init.sh
+# as /init.
 #   tools/vm/build-initramfs.sh OUT.cpio.gz GPIO_SIM_KO BINARY...
 set -euo pipefail
 out=$(realpath -m "$1")
@@ -49,6 +50,9 @@ for p in "${progs[@]}"; do
     cp -L "$lib" "$dest"
   done
 done
+# The DBC for hrg can-decode in the guest.
+mkdir -p "$stage/etc"
+cp "$here/../../firmware/can/hrg.dbc" "$stage/etc/hrg.dbc"
 cp "$here/guest-init.sh" "$stage/init"
 chmod +x "$stage/init"
 (cd "$stage" && find . | cpio -o -H newc --quiet | gzip -1) > "$out"
