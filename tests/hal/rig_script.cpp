@@ -96,6 +96,7 @@ int check_log(const char* path) {
   int status_mode = -1, status_exc = -1, bus_off = 0, restarts = 0;
   int wave_after_restart = 0;
   bool ident_stopped = false;
+  const long long wave_hz = can::telemetry_def(can::Tm::wave_x).default_rate_hz;
   while (reader.next(lf)) {
     const CanFrame& f = lf.frame;
     const double t = static_cast<double>(lf.t_ns) * 1e-9;
@@ -115,10 +116,11 @@ int check_log(const char* path) {
     losses[f.id] += gap;
     last_seq[f.id] = seq;
     if (f.id == can::telemetry_def(can::Tm::wave_x).id) {
-      // Window edges are measured in samples (HRG_WAVE_X frames at 500 Hz, lost
-      // ones included through seq): the firmware's time base, exact whatever
-      // the scheduling. The 1.0 s / 0.2 s schedule is 500 / 100 samples. The
-      // log's receive time of each edge is reported beside it.
+      // Window edges are measured in samples (HRG_WAVE_X frames at their
+      // rate, lost ones included through seq): the firmware's time base, exact
+      // whatever the scheduling. The 1.0 s / 0.2 s schedule is 100 / 20
+      // samples at 100 Hz. The log's receive time of each edge is reported
+      // beside it.
       wave_index += 1 + gap;
       const int exc = static_cast<int>(sig(f, "exc"));
       if (gap != 0 || ident_stopped) {  // an edge may have been lost: start over
@@ -130,7 +132,7 @@ int check_log(const char* path) {
         if (n_last_fall >= 0) {
           const double wall_err_ms = 1e3 * std::fabs(t - t_last_fall - 1.0);
           if (wall_err_ms > max_wall_err_ms) max_wall_err_ms = wall_err_ms;
-          if (wave_index - n_last_fall != 500) {
+          if (wave_index - n_last_fall != wave_hz) {
             std::printf("check: window period %lld samples\n", wave_index - n_last_fall);
             ++bad_spacing;
           }
@@ -140,7 +142,7 @@ int check_log(const char* path) {
         t_last_fall = t;
         ++falls;
       }
-      if (last_exc == 0 && exc == 1 && n_fall >= 0 && wave_index - n_fall != 100) {
+      if (last_exc == 0 && exc == 1 && n_fall >= 0 && wave_index - n_fall != wave_hz / 5) {
         std::printf("check: window length %lld samples\n", wave_index - n_fall);
         ++bad_length;
       }
@@ -173,10 +175,10 @@ int check_log(const char* path) {
                 losses[m.id]);
     if (count[m.id] == 0) rc |= fail(m.name);
   }
-  // Frames the rig could not send while bus-off (100 ms before its restart, 50
-  // wave frames) are lost by design; beyond that at most 1 % may be.
+  // Frames the rig could not send while bus-off (100 ms before its restart, a
+  // tenth of the wave rate) are lost by design; beyond that at most 1 % may be.
   const uint32_t wave = can::telemetry_def(can::Tm::wave_x).id;
-  if (losses[wave] > 55 * bus_off + count[wave] / 100) {
+  if (losses[wave] > (wave_hz / 10 + 5) * bus_off + count[wave] / 100) {
     rc |= fail("HRG_WAVE_X losses beyond the bus-off interval");
   }
   std::printf(
@@ -192,7 +194,9 @@ int check_log(const char* path) {
     rc |= fail("safe mode not applied");
   std::printf("check: bus-off events %d, restarts %d, HRG_WAVE_X after the restart %d\n", bus_off,
               restarts, wave_after_restart);
-  if (bus_off < 1 || restarts < 1 || wave_after_restart < 100) rc |= fail("bus-off not survived");
+  // At least 0.2 s of wave frames after the restart.
+  if (bus_off < 1 || restarts < 1 || wave_after_restart < wave_hz / 5)
+    rc |= fail("bus-off not survived");
   std::printf("check: %s\n", rc == 0 ? "PASS" : "FAIL");
   return rc;
 }
