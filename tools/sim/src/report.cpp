@@ -64,6 +64,16 @@ bool judge(const JobConfig& job, JobResult& r) {
             "with the model (last misfit %.1f); the output is the raw angle",
             r.model_checks_failed, r.last_window_misfit));
   }
+  if (r.calibration.verdict == fw::app::CalibrationVerdict::withdrawn) {
+    const fw::app::CalibrationStatus& c = r.calibration;
+    const std::string before =
+        c.misfit_before > 0.0 ? fmt(" and the check before it (%.2f)", c.misfit_before) : "";
+    r.failures.push_back(
+        fmt("the %s calibration was withdrawn at %.1f s: its check window's "
+            "misfit %.2f is above the noise (%.1f)%s; the pickoffs are read raw",
+            fw::app::to_string(c.source), c.judged_s, c.misfit_after,
+            job.firmware.gyro.max_window_misfit, before.c_str()));
+  }
   if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
       r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
     r.failures.push_back(
@@ -75,6 +85,21 @@ bool judge(const JobConfig& job, JobResult& r) {
 }
 
 namespace {
+
+// The calibration's trial: where it came from, the check window that judged
+// it (misfits over the fit's own residual), withdrawn or not.
+void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c) {
+  w.begin_object("calibration");
+  w.string("source", fw::app::to_string(c.source));
+  w.string("verdict", fw::app::to_string(c.verdict));
+  w.integer("crc32", c.crc32);
+  w.number("applied_s", c.applied_s);
+  w.number("misfit_before", c.misfit_before);
+  w.number("misfit_after", c.misfit_after);
+  w.number("judged_s", c.judged_s);
+  w.integer("withdrawals", c.withdrawals);
+  w.end_object();
+}
 
 void drift_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("drift");
@@ -200,6 +225,7 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   // The calibration in force (CRC-32 of its canonical form, as hrg
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
+  calibration_json(w, r.calibration);
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "firmware/app/calibration_guard.hpp"
 #include "firmware/app/firmware_config.hpp"
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/estimator_port.hpp"
@@ -23,8 +24,9 @@ class Firmware {
       : cfg_(cfg),
         chain_(cfg.chain),
         estimator_(cfg.estimator),
-        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {
-    calibration_ok_ = apply_calibration(cfg.calibration);
+        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro),
+        guard_(cfg.gyro.max_window_misfit) {
+    calibration_ok_ = apply_calibration(cfg.calibration, CalibrationSource::file);
   }
   Firmware(const Firmware&) = delete;
   Firmware& operator=(const Firmware&) = delete;
@@ -42,11 +44,19 @@ class Firmware {
   // Puts `cal` in force: the pickoff-map inverse and the feedthrough removal
   // on the chain's demodulated quadratures. All or nothing: false (the one in
   // force stays) when a field is out of range or a coefficient does not fit
-  // the chain's Q formats.
-  bool apply_calibration(const Calibration& cal);
+  // the chain's Q formats. The one way a calibration enters the firmware
+  // (file at start, online self-calibration, CAN block): it is then on trial
+  // until the next check window judges it (CalibrationGuard), and withdrawn
+  // if that one disagrees.
+  bool apply_calibration(const Calibration& cal, CalibrationSource source);
+  // The calibration in force (the identity after a withdrawal) and its trial.
   const Calibration& calibration() const { return cfg_.calibration; }
+  const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  void run_frame() { gyro_.run_frame(); }
+  void run_frame() {
+    gyro_.run_frame();
+    judge_calibration();
+  }
   Gyro& gyro() { return gyro_; }
   const Gyro& gyro() const { return gyro_; }
   const DspChainPort& chain() const { return chain_; }
@@ -54,10 +64,16 @@ class Firmware {
   const FirmwareConfig& config() const { return cfg_; }
 
  private:
+  // Withdraws the calibration in force when its check window disagreed.
+  void judge_calibration();
+  // The estimator's check windows count (the campaign is over, or none runs).
+  bool checking() const;
+
   FirmwareConfig cfg_;
   DspChainPort chain_;
   EstimatorPort estimator_;
   Gyro gyro_;
+  CalibrationGuard guard_;
   bool calibration_ok_ = true;
 };
 
