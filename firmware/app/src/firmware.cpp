@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "firmware/app/firmware.hpp"
 
+#include <cmath>
+
 namespace hrg::fw::app {
 
 namespace {
@@ -10,6 +12,11 @@ bool is_identity_electronics(const Calibration& cal) {
          cal.pickoff_y_misalignment_rad == 0.0 && cal.feedthrough_x_re_v_per_v == 0.0 &&
          cal.feedthrough_x_im_v_per_v == 0.0 && cal.feedthrough_y_re_v_per_v == 0.0 &&
          cal.feedthrough_y_im_v_per_v == 0.0;
+}
+
+bool significant(const est::PickoffSelfCalResult& r, double n_sigma) {
+  return std::fabs(r.gain) > n_sigma * r.gain_sigma ||
+         std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad;
 }
 
 }  // namespace
@@ -33,6 +40,30 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
 
 bool Firmware::checking() const {
   return gyro_.config().identify ? gyro_.scheduler().campaign_done() : estimator_.health().solved;
+}
+
+void Firmware::self_calibrate() {
+  const est::PickoffSelfCalResult& r = estimator_.pickoff_self_calibration();
+  // Once per fresh solve, never inside a window (the identifier restarts).
+  if (r.samples == self_cal_samples_seen_ || gyro_.status().mode != Mode::operate) return;
+  self_cal_samples_seen_ = r.samples;
+  if (r.status != est::Status::ok || !significant(r, kSelfCalSignificance) ||
+      self_cal_.rounds >= kMaxSelfCalRounds) {
+    return;
+  }
+  // The estimate is the residual map seen through the correction in force:
+  // the gains compose, the misalignments add.
+  Calibration next = cfg_.calibration;
+  next.pickoff_y_gain = (1.0 + next.pickoff_y_gain) * (1.0 + r.gain) - 1.0;
+  next.pickoff_y_misalignment_rad += r.misalignment_rad;
+  if (!apply_calibration(next, CalibrationSource::online)) return;
+  ++self_cal_.rounds;
+  self_cal_.applied = r;
+  self_cal_.applied_s = gyro_.status().chain.t_s;
+  // Every window so far was taken through the old correction.
+  estimator_.restart();
+  gyro_.restart_identification();
+  self_cal_samples_seen_ = 0;
 }
 
 void Firmware::judge_calibration() {

@@ -14,6 +14,7 @@ namespace hrg::simtools {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
+constexpr double kDegRad = kPi / 180.0;
 constexpr const char* kParamNames[5] = {"nu_per_s", "dnu_c_per_s", "dnu_s_per_s", "dw_c_rad_s",
                                         "dw_s_rad_s"};
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
@@ -98,6 +99,38 @@ void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c) {
   w.number("misfit_after", c.misfit_after);
   w.number("judged_s", c.judged_s);
   w.integer("withdrawals", c.withdrawals);
+  w.end_object();
+}
+
+const char* solve_status(est::Status s) {
+  switch (s) {
+    case est::Status::ok: return "ok";
+    case est::Status::no_data: return "no_data";
+    case est::Status::ill_conditioned: return "ill_conditioned";
+    default: return "refused";
+  }
+}
+
+// The pickoff self-calibration's last solve (est::PickoffSelfCalibration).
+void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
+                           const fw::app::SelfCalibrationStatus& applied) {
+  w.begin_object("self_calibration");
+  w.integer("rounds_applied", applied.rounds);
+  w.number("last_applied_s", applied.applied_s);
+  w.number("last_applied_gain", applied.applied.gain);
+  w.number("last_applied_gain_sigma", applied.applied.gain_sigma);
+  w.number("last_applied_misalignment_deg", applied.applied.misalignment_rad / kDegRad);
+  w.number("last_applied_misalignment_sigma_deg", applied.applied.misalignment_sigma_rad / kDegRad);
+  // The last solve (after the last round: the residual left).
+  w.string("status", solve_status(s.status));
+  w.number("gain", s.gain);
+  w.number("gain_sigma", s.gain_sigma);
+  w.number("misalignment_deg", s.misalignment_rad / kDegRad);
+  w.number("misalignment_sigma_deg", s.misalignment_sigma_rad / kDegRad);
+  w.number("kappa", s.kappa_2);
+  w.number("residual_rms", s.residual_rms);
+  w.integer("windows", s.windows);
+  w.integer("turning_windows", s.turning_windows);
   w.end_object();
 }
 
@@ -226,6 +259,7 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
   calibration_json(w, r.calibration);
+  self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);

@@ -10,6 +10,13 @@
 
 namespace hrg::fw::app {
 
+// What the online pickoff self-calibration has put in force.
+struct SelfCalibrationStatus {
+  uint32_t rounds = 0;                  // estimates applied (each restarts the identification)
+  est::PickoffSelfCalResult applied{};  // the last one applied (the residual it removed)
+  double applied_s = 0.0;               // when
+};
+
 // The firmware assembled on a board: the signal chain over dsp::Chain, the
 // estimator and the gyro (executive, modes, windows, output, CAN) that runs
 // them. The only place where the parts are put together; the main job
@@ -53,10 +60,18 @@ class Firmware {
   const Calibration& calibration() const { return cfg_.calibration; }
   const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
+  // An estimate is applied when its solve is accepted (conditioning) and it
+  // stands out of its own noise by this many sigma, at most kMaxSelfCalRounds
+  // times (each round removes the previous one's second-order residual).
+  static constexpr double kSelfCalSignificance = 5.0;
+  static constexpr uint32_t kMaxSelfCalRounds = 3;
+
   void run_frame() {
     gyro_.run_frame();
     judge_calibration();
+    if (cfg_.online_pickoff_calibration) self_calibrate();
   }
+  const SelfCalibrationStatus& self_calibration() const { return self_cal_; }
   Gyro& gyro() { return gyro_; }
   const Gyro& gyro() const { return gyro_; }
   const DspChainPort& chain() const { return chain_; }
@@ -66,6 +81,9 @@ class Firmware {
  private:
   // Withdraws the calibration in force when its check window disagreed.
   void judge_calibration();
+  // Folds a fresh, significant self-calibration estimate into the
+  // correction and starts the identification again.
+  void self_calibrate();
   // The estimator's check windows count (the campaign is over, or none runs).
   bool checking() const;
 
@@ -74,6 +92,8 @@ class Firmware {
   EstimatorPort estimator_;
   Gyro gyro_;
   CalibrationGuard guard_;
+  SelfCalibrationStatus self_cal_{};
+  int self_cal_samples_seen_ = 0;
   bool calibration_ok_ = true;
 };
 
