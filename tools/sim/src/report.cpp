@@ -89,8 +89,13 @@ namespace {
 
 // The calibration's trial: where it came from, the check window that judged
 // it (misfits over the fit's own residual), withdrawn or not.
-void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c) {
+void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
+                      const fw::Calibration& in_force) {
   w.begin_object("calibration");
+  // The pickoff map in force at the end (after a withdrawal: the identity).
+  w.number("pickoff_y_gain", in_force.pickoff_y_gain);
+  w.number("pickoff_y_phase_deg", in_force.pickoff_y_phase_rad / kDegRad);
+  w.number("pickoff_y_misalignment_deg", in_force.pickoff_y_misalignment_rad / kDegRad);
   w.string("source", fw::app::to_string(c.source));
   w.string("verdict", fw::app::to_string(c.verdict));
   w.integer("crc32", c.crc32);
@@ -258,7 +263,7 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   // The calibration in force (CRC-32 of its canonical form, as hrg
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
-  calibration_json(w, r.calibration);
+  calibration_json(w, r.calibration, r.final_calibration);
   self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
   w.end_object();
   identification_json(w, r);
