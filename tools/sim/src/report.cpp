@@ -126,6 +126,8 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.number("last_applied_gain_sigma", applied.applied.gain_sigma);
   w.number("last_applied_misalignment_deg", applied.applied.misalignment_rad / kDegRad);
   w.number("last_applied_misalignment_sigma_deg", applied.applied.misalignment_sigma_rad / kDegRad);
+  w.number("last_applied_residual_rms", applied.applied.residual_rms);
+  w.number("last_applied_kappa", applied.applied.kappa_2);
   // The last solve (after the last round: the residual left).
   w.string("status", solve_status(s.status));
   w.number("gain", s.gain);
