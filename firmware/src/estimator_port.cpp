@@ -5,7 +5,24 @@
 
 namespace hrg::fw {
 
-void EstimatorPort::begin_window(double t_s) { (void)est_.begin_window(t_s); }
+void EstimatorPort::begin_window(double t_s) {
+  (void)est_.begin_window(t_s);
+  (void)self_cal_.begin_window();
+}
+
+void EstimatorPort::end_self_cal_window() {
+  if (self_cal_.end_window() == est::Status::ok) self_cal_dirty_ = true;
+}
+
+void EstimatorPort::restart() {
+  est_ = est::Estimator(cfg_);
+  self_cal_.reset();
+  self_cal_result_ = {};
+  health_ = {};
+  dirty_ = false;
+  self_cal_dirty_ = false;
+  last_control_t_s_ = -1.0;
+}
 
 void EstimatorPort::add_sample(const ChainRecord& s) {
   est::WaveSample w;
@@ -14,11 +31,13 @@ void EstimatorPort::add_sample(const ChainRecord& s) {
   w.a_B_v = s.wave.a_B;
   w.theta_A_rad = s.theta_A_rad;
   w.E_v2 = s.wave.E;
-  // Settling samples and sequencing errors are the accumulator's to count.
-  (void)est_.add_sample(w);
+  // Settling samples and sequencing errors are the accumulator's to count;
+  // the self-calibration takes the samples the accumulator took.
+  if (est_.add_sample(w) == est::Status::ok) (void)self_cal_.add_sample(w);
 }
 
 void EstimatorPort::end_window() {
+  end_self_cal_window();
   if (est_.end_window() == est::Status::ok) {
     ++windows_ok_;
     dirty_ = true;
@@ -30,6 +49,7 @@ void EstimatorPort::end_window() {
 }
 
 void EstimatorPort::end_check_window() {
+  end_self_cal_window();
   if (est_.end_window(false) == est::Status::ok) {
     ++windows_ok_;  // accepted as a check (nothing new to solve)
     health_.window_misfit = est_.last_window_misfit();
@@ -42,6 +62,7 @@ void EstimatorPort::end_check_window() {
 void EstimatorPort::abort_window() {
   // A window cut short by a fault is dropped: its last samples may already
   // show the fault, and a short window is worth little anyway.
+  self_cal_.abort_window();
   if (!est_.window().window_open()) return;
   est_.abort_window();
   ++windows_bad_;
@@ -73,6 +94,10 @@ double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {
 }
 
 void EstimatorPort::solve() {
+  if (self_cal_dirty_) {
+    self_cal_dirty_ = false;
+    self_cal_result_ = self_cal_.solve();
+  }
   if (!dirty_) return;
   dirty_ = false;
   const est::Solution s = est_.solve_and_accept();

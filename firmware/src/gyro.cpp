@@ -263,9 +263,18 @@ void Gyro::check_model() {
   // are good) until a check window disagrees; then withdrawn for good.
   // Reported valid only once a check window (on a still base first, where
   // a fit made while turning is most likely wrong) agreed with it.
-  status_.compensation_applied = status_.model_checks_failed == 0;
+  status_.compensation_applied = status_.model_checks_failed == failed_before_restart_;
   const bool checked = cfg_.identify && cfg_.windows.check_period_frames != 0;
   status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0);
+}
+
+void Gyro::restart_identification() {
+  scheduler_ = WindowScheduler(cfg_.windows);
+  compensation_ready_ = false;
+  checks_passed_ = 0;
+  failed_before_restart_ = status_.model_checks_failed;
+  status_.compensation_applied = false;
+  status_.compensation_valid = false;
 }
 
 void Gyro::task_solve(Gyro& g) {

@@ -2,8 +2,9 @@
 // Cost of the estimator's steps, for callgrind (bench_cost.cmake counts the
 // instructions inside each hrg_bench_est_* function and divides by its count).
 //   bench_estimator_cost <op> <count>
-//   op: sample | window | solve | solve_alt | output
+//   op: sample | window | solve | solve_alt | output | selfcal_sample | selfcal_solve
 #include <estimator/estimator.hpp>
+#include <estimator/pickoff_self_calibration.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -34,6 +35,44 @@ std::vector<WaveSample> window_samples(double theta0, double t0) {
 }  // namespace
 
 extern "C" {
+void hrg_bench_selfcal_sample(PickoffSelfCalibration& cal, const WaveSample* s, int n);
+PickoffSelfCalResult hrg_bench_selfcal_solve(const PickoffSelfCalibration& cal);
+}
+
+namespace {
+// 16 windows while the pattern turns (the synthetic decay at rest, turned
+// by hand so that the level regressors vary), then the op.
+int run_self_calibration(const char* op, int count) {
+  PickoffSelfCalibration cal;
+  const bool sample_op = std::strcmp(op, "selfcal_sample") == 0;
+  double sink = 0;
+  for (int k = 0; k < 16; ++k) {
+    auto samples = window_samples(0.05 + k * M_PI / 32, 10.0 * k);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      samples[i].theta_A_rad += (k % 3) * 0.05 * 1e-3 * static_cast<double>(i);
+    const int reps = sample_op && k == 15 ? count : 1;
+    for (int r = 0; r < reps; ++r) {
+      cal.abort_window();
+      cal.begin_window();
+      if (sample_op && k == 15) {
+        hrg_bench_selfcal_sample(cal, samples.data(), kWindowSamples);
+      } else {
+        for (const auto& s : samples)
+          cal.add_sample(s);
+      }
+    }
+    cal.end_window();
+  }
+  if (!sample_op) {
+    for (int r = 0; r < count; ++r)
+      sink += hrg_bench_selfcal_solve(cal).gain;
+  }
+  std::printf("%s %d %.3e\n", op, count, sink);
+  return 0;
+}
+}  // namespace
+
+extern "C" {
 // Settled samples only (the settle rule is a comparison).
 __attribute__((noipa)) void hrg_bench_est_sample(WindowAccumulator& acc, const WaveSample* s,
                                                  int n) {
@@ -47,6 +86,17 @@ __attribute__((noipa)) void hrg_bench_est_window(WindowAccumulator& acc, NormalE
 __attribute__((noipa)) Solution hrg_bench_est_solve(const NormalEquations& ls, Variant v) {
   return ls.solve(v);
 }
+// The pickoff self-calibration's per-sample step (runs beside add_sample in
+// every window) and its solve (after every window).
+__attribute__((noipa)) void hrg_bench_selfcal_sample(PickoffSelfCalibration& cal,
+                                                     const WaveSample* s, int n) {
+  for (int i = 0; i < n; ++i)
+    cal.add_sample(s[i]);
+}
+__attribute__((noipa)) PickoffSelfCalResult hrg_bench_selfcal_solve(
+    const PickoffSelfCalibration& cal) {
+  return cal.solve();
+}
 __attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n) {
   double c = 0;
   for (int i = 0; i < n; ++i)
@@ -57,11 +107,15 @@ __attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: %s sample|window|solve|solve_alt|output <count>\n", argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s sample|window|solve|solve_alt|output|selfcal_sample|selfcal_solve "
+                 "<count>\n",
+                 argv[0]);
     return 2;
   }
   const char* op = argv[1];
   const int count = std::atoi(argv[2]);
+  if (std::strncmp(op, "selfcal", 7) == 0) return run_self_calibration(op, count);
   // A well-covered state to solve: 16 windows.
   NormalEquations ls;
   WindowAccumulator acc;

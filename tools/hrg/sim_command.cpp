@@ -25,7 +25,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
     "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
-    "               [--no-control-drift] [--calibration FILE] [--profile] [--quiet]\n\n"
+    "               [--no-control-drift] [--calibration FILE] [--self-calibrate]\n"
+    "               [--profile] [--quiet]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -48,6 +49,9 @@ constexpr const char* kUsage =
     "--calibration FILE puts a calibration (hrg audit --calibration) in force:\n"
     "the pickoff-map inverse and the drive-feedthrough removal on the chain's\n"
     "demodulated quadratures.\n"
+    "--self-calibrate lets the firmware identify the pickoff gain mismatch and\n"
+    "misalignment from its own windows and apply them when the estimate is well\n"
+    "conditioned and significant (the identification then starts again).\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
 
 bool parse_double(std::string_view s, double& out) {
@@ -68,6 +72,7 @@ struct SimOptions {
   int bias_angles = 0;  // not given: the schedule's default
   bool plots = true, quiet = false, real_time = false, static_base = false, profile = false;
   bool control_drift = true;
+  bool self_calibrate = false;
 };
 
 // Parses the command line into `o`. Returns -1 to go on, else the exit
@@ -113,6 +118,8 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
       o.static_base = true;
     } else if (a == "--real-time") {
       o.real_time = true;
+    } else if (a == "--self-calibrate") {
+      o.self_calibrate = true;
     } else if (a == "--no-control-drift") {
       o.control_drift = false;
     } else if (a == "--no-plots") {
@@ -134,6 +141,7 @@ simtools::JobConfig make_job(const SimOptions& o) {
   simtools::JobConfig job =
       simtools::make_job(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
   job.firmware.gyro.compensate_control_drift = o.control_drift;
+  job.firmware.online_pickoff_calibration = o.self_calibrate;
   if (!o.calibration.empty())
     job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
   return job;

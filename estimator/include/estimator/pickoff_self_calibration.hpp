@@ -66,6 +66,8 @@ class PickoffSelfCalibration {
   Status begin_window();
   // One control-rate sample inside the window (t_s strictly increasing).
   Status add_sample(const WaveSample& s);
+  // Drops the open window (cut short by a fault): nothing of it is folded.
+  void abort_window() { open_ = false; }
   // Folds the window into the normal equations (too_short below min_samples).
   Status end_window(int min_samples = 50);
   // Solves; ill_conditioned when no window turned (g and b unseen) or when

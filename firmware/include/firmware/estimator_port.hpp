@@ -2,6 +2,7 @@
 #pragma once
 
 #include "estimator/estimator.hpp"
+#include "estimator/pickoff_self_calibration.hpp"
 #include "firmware/ports.hpp"
 
 namespace hrg::fw {
@@ -11,7 +12,7 @@ namespace hrg::fw {
 // accepts the model when the conditioning allows, the drift is eq. 22.
 class EstimatorPort final : public ResonatorIdentifier {
  public:
-  explicit EstimatorPort(const est::Estimator::Config& cfg) : est_(cfg) {}
+  explicit EstimatorPort(const est::Estimator::Config& cfg) : cfg_(cfg), est_(cfg) {}
 
   void begin_window(double t_s) override;
   void add_sample(const ChainRecord& s) override;
@@ -28,14 +29,26 @@ class EstimatorPort final : public ResonatorIdentifier {
   double control_drift_rad_s(double theta_a_rad) const override;
 
   const est::Estimator& estimator() const { return est_; }
+  // The pickoff self-calibration over the same windows (campaign and check
+  // windows alike): its last solve (re-solved after every window).
+  const est::PickoffSelfCalResult& pickoff_self_calibration() const { return self_cal_result_; }
+  // Forgets every window (model, D_Phi, self-calibration): the signals they
+  // were taken on changed (a new pickoff correction).
+  void restart();
   uint32_t windows_accepted() const { return windows_ok_; }
   uint32_t windows_rejected() const { return windows_bad_; }
   uint32_t solves_accepted() const { return solves_ok_; }
 
  private:
+  void end_self_cal_window();
+
+  est::Estimator::Config cfg_;
   est::Estimator est_;
+  est::PickoffSelfCalibration self_cal_;
+  est::PickoffSelfCalResult self_cal_result_{};
   EstimatorHealth health_{};
-  bool dirty_ = false;  // a window was added since the last solve
+  bool dirty_ = false;           // a window was added since the last solve
+  bool self_cal_dirty_ = false;  // a window was added to the self-calibration
   // Control samples further apart than this (s) restart the D_Phi blocks.
   static constexpr double kMaxControlGapS = 0.0015;
   double last_control_t_s_ = -1.0;

@@ -103,6 +103,10 @@ class Gyro {
   void release_pattern();
   void command_safe() { mode_.handle(Event::command_safe); }
   void command_restart() { mode_.handle(Event::command_restart); }
+  // A new window campaign from scratch, the model checks with it (the
+  // signals the identifier saw changed: a new pickoff correction). The
+  // identifier is restarted by its owner. Call outside a window.
+  void restart_identification();
   // Re-zeroes the output angle at the current pattern angle.
   void zero_output() { output_.rereference(); }
 
@@ -183,6 +187,7 @@ class Gyro {
   bool compensation_ready_ = false;
   uint32_t checks_seen_ = 0;
   uint32_t checks_passed_ = 0;
+  uint32_t failed_before_restart_ = 0;  // model_checks_failed when the campaign restarted
   double host_pattern_target_rad_ = 0.0;
   bool enable_written_ = false;
   bool board_ok_ = true;

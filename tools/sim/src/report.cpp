@@ -14,6 +14,7 @@ namespace hrg::simtools {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
+constexpr double kDegRad = kPi / 180.0;
 constexpr const char* kParamNames[5] = {"nu_per_s", "dnu_c_per_s", "dnu_s_per_s", "dw_c_rad_s",
                                         "dw_s_rad_s"};
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
@@ -64,6 +65,16 @@ bool judge(const JobConfig& job, JobResult& r) {
             "with the model (last misfit %.1f); the output is the raw angle",
             r.model_checks_failed, r.last_window_misfit));
   }
+  if (r.calibration.verdict == fw::app::CalibrationVerdict::withdrawn) {
+    const fw::app::CalibrationStatus& c = r.calibration;
+    const std::string before =
+        c.misfit_before > 0.0 ? fmt(" and the check before it (%.2f)", c.misfit_before) : "";
+    r.failures.push_back(
+        fmt("the %s calibration was withdrawn at %.1f s: its check window's "
+            "misfit %.2f is above the noise (%.1f)%s; the pickoffs are read raw",
+            fw::app::to_string(c.source), c.judged_s, c.misfit_after,
+            job.firmware.gyro.max_window_misfit, before.c_str()));
+  }
   if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
       r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
     r.failures.push_back(
@@ -75,6 +86,60 @@ bool judge(const JobConfig& job, JobResult& r) {
 }
 
 namespace {
+
+// The calibration's trial: where it came from, the check window that judged
+// it (misfits over the fit's own residual), withdrawn or not.
+void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
+                      const fw::Calibration& in_force) {
+  w.begin_object("calibration");
+  // The pickoff map in force at the end (after a withdrawal: the identity).
+  w.number("pickoff_y_gain", in_force.pickoff_y_gain);
+  w.number("pickoff_y_phase_deg", in_force.pickoff_y_phase_rad / kDegRad);
+  w.number("pickoff_y_misalignment_deg", in_force.pickoff_y_misalignment_rad / kDegRad);
+  w.string("source", fw::app::to_string(c.source));
+  w.string("verdict", fw::app::to_string(c.verdict));
+  w.integer("crc32", c.crc32);
+  w.number("applied_s", c.applied_s);
+  w.number("misfit_before", c.misfit_before);
+  w.number("misfit_after", c.misfit_after);
+  w.number("judged_s", c.judged_s);
+  w.integer("withdrawals", c.withdrawals);
+  w.end_object();
+}
+
+const char* solve_status(est::Status s) {
+  switch (s) {
+    case est::Status::ok: return "ok";
+    case est::Status::no_data: return "no_data";
+    case est::Status::ill_conditioned: return "ill_conditioned";
+    default: return "refused";
+  }
+}
+
+// The pickoff self-calibration's last solve (est::PickoffSelfCalibration).
+void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
+                           const fw::app::SelfCalibrationStatus& applied) {
+  w.begin_object("self_calibration");
+  w.integer("rounds_applied", applied.rounds);
+  w.number("last_applied_s", applied.applied_s);
+  w.number("last_applied_gain", applied.applied.gain);
+  w.number("last_applied_gain_sigma", applied.applied.gain_sigma);
+  w.number("last_applied_misalignment_deg", applied.applied.misalignment_rad / kDegRad);
+  w.number("last_applied_misalignment_sigma_deg", applied.applied.misalignment_sigma_rad / kDegRad);
+  w.number("last_applied_residual_rms", applied.applied.residual_rms);
+  w.number("last_applied_kappa", applied.applied.kappa_2);
+  // The last solve (after the last round: the residual left).
+  w.string("status", solve_status(s.status));
+  w.number("gain", s.gain);
+  w.number("gain_sigma", s.gain_sigma);
+  w.number("misalignment_deg", s.misalignment_rad / kDegRad);
+  w.number("misalignment_sigma_deg", s.misalignment_sigma_rad / kDegRad);
+  w.number("kappa", s.kappa_2);
+  w.number("residual_rms", s.residual_rms);
+  w.integer("windows", s.windows);
+  w.integer("turning_windows", s.turning_windows);
+  w.end_object();
+}
 
 void drift_json(JsonWriter& w, const JobResult& r) {
   w.begin_object("drift");
@@ -200,6 +265,8 @@ std::string report_json(const JobConfig& job, const JobResult& r) {
   // The calibration in force (CRC-32 of its canonical form, as hrg
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
+  calibration_json(w, r.calibration, r.final_calibration);
+  self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);

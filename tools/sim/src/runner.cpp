@@ -376,6 +376,10 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   r.compensation_applied = gyro.status().compensation_applied;
   r.model_checks_failed = gyro.status().model_checks_failed;
   r.last_window_misfit = firmware->estimator().health().window_misfit;
+  r.calibration = firmware->calibration_status();
+  r.self_calibration = firmware->estimator().pickoff_self_calibration();
+  r.self_calibration_applied = firmware->self_calibration();
+  r.final_calibration = firmware->calibration();
   r.can_bus_off_events = target.can().counters().bus_off_events;
   r.can_restarts = gyro.can_restarts();
   summarise_identification(r, job, *firmware);

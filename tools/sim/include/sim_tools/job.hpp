@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "firmware/app/calibration_guard.hpp"
+#include "estimator/pickoff_self_calibration.hpp"
+#include "firmware/app/firmware.hpp"
 #include "firmware/app/firmware_config.hpp"
 #include "sim_target/control.hpp"
 #include "sim_target/sim_config.hpp"
@@ -140,6 +143,12 @@ struct JobResult {
   bool compensation_applied = false;
   uint32_t model_checks_failed = 0;
   double last_window_misfit = 0.0;
+  // The calibration's trial (source, verdict, the misfits that judged it).
+  fw::app::CalibrationStatus calibration{};
+  // The firmware's pickoff self-calibration at the end (its last solve).
+  est::PickoffSelfCalResult self_calibration{};
+  fw::app::SelfCalibrationStatus self_calibration_applied{};
+  fw::Calibration final_calibration{};  // the calibration in force at the end
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;

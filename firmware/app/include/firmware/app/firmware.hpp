@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "firmware/app/calibration_guard.hpp"
 #include "firmware/app/firmware_config.hpp"
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/estimator_port.hpp"
@@ -8,6 +9,13 @@
 #include "hal/board.hpp"
 
 namespace hrg::fw::app {
+
+// What the online pickoff self-calibration has put in force.
+struct SelfCalibrationStatus {
+  uint32_t rounds = 0;                  // estimates applied (each restarts the identification)
+  est::PickoffSelfCalResult applied{};  // the last one applied (the residual it removed)
+  double applied_s = 0.0;               // when
+};
 
 // The firmware assembled on a board: the signal chain over dsp::Chain, the
 // estimator and the gyro (executive, modes, windows, output, CAN) that runs
@@ -23,8 +31,9 @@ class Firmware {
       : cfg_(cfg),
         chain_(cfg.chain),
         estimator_(cfg.estimator),
-        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro) {
-    calibration_ok_ = apply_calibration(cfg.calibration);
+        gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro),
+        guard_(cfg.gyro.max_window_misfit) {
+    calibration_ok_ = apply_calibration(cfg.calibration, CalibrationSource::file);
     // A calibration written over CAN takes the same path.
     gyro_.set_calibration_apply(&Firmware::apply_from_can, this, cfg_.calibration);
   }
@@ -44,11 +53,27 @@ class Firmware {
   // Puts `cal` in force: the pickoff-map inverse and the feedthrough removal
   // on the chain's demodulated quadratures. All or nothing: false (the one in
   // force stays) when a field is out of range or a coefficient does not fit
-  // the chain's Q formats.
-  bool apply_calibration(const Calibration& cal);
+  // the chain's Q formats. The one way a calibration enters the firmware
+  // (file at start, online self-calibration, CAN block): it is then on trial
+  // until the next check window judges it (CalibrationGuard), and withdrawn
+  // if that one disagrees.
+  bool apply_calibration(const Calibration& cal, CalibrationSource source);
+  // The calibration in force (the identity after a withdrawal) and its trial.
   const Calibration& calibration() const { return cfg_.calibration; }
+  const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  void run_frame() { gyro_.run_frame(); }
+  // An estimate is applied when its solve is accepted (conditioning) and it
+  // stands out of its own noise by this many sigma, at most kMaxSelfCalRounds
+  // times (each round removes the previous one's second-order residual).
+  static constexpr double kSelfCalSignificance = 5.0;
+  static constexpr uint32_t kMaxSelfCalRounds = 3;
+
+  void run_frame() {
+    gyro_.run_frame();
+    judge_calibration();
+    if (cfg_.online_pickoff_calibration) self_calibrate();
+  }
+  const SelfCalibrationStatus& self_calibration() const { return self_cal_; }
   Gyro& gyro() { return gyro_; }
   const Gyro& gyro() const { return gyro_; }
   const DspChainPort& chain() const { return chain_; }
@@ -56,14 +81,25 @@ class Firmware {
   const FirmwareConfig& config() const { return cfg_; }
 
  private:
+  // Withdraws the calibration in force when its check window disagreed.
+  void judge_calibration();
+  // Folds a fresh, significant self-calibration estimate into the
+  // correction and starts the identification again.
+  void self_calibrate();
+  // The estimator's check windows count (the campaign is over, or none runs).
+  bool checking() const;
+
   FirmwareConfig cfg_;
   DspChainPort chain_;
   EstimatorPort estimator_;
   Gyro gyro_;
+  CalibrationGuard guard_;
+  SelfCalibrationStatus self_cal_{};
+  int self_cal_samples_seen_ = 0;
   bool calibration_ok_ = true;
 
   static bool apply_from_can(void* self, const Calibration& cal) {
-    return static_cast<Firmware*>(self)->apply_calibration(cal);
+    return static_cast<Firmware*>(self)->apply_calibration(cal, CalibrationSource::can);
   }
 };
 

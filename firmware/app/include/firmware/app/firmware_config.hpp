@@ -21,6 +21,10 @@ struct FirmwareConfig {
   // What the firmware corrects of this gyro's electronics (the identity by
   // default; a file, a CAN block or the built-in constant on bare metal).
   Calibration calibration = kIdentityCalibration;
+  // The pickoff self-calibration's estimate (gain, misalignment) folded into
+  // the correction in force when it is well conditioned and significant
+  // (Firmware::self_calibrate); the identification then starts again.
+  bool online_pickoff_calibration = false;
 };
 
 // How the free-decay windows identify the resonator.

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Do no harm for a calibration: one put in force (a file, the online
+// self-calibration, a CAN block) is on trial until the firmware's own model
+// check has judged it. The first check window after it (the campaign's own
+// windows prove nothing) must be consistent with the noise (misfit at most
+// the gyro's max_window_misfit) or, when a check was made before it was
+// applied, not worse than that one. Otherwise it is withdrawn (the chain
+// goes back to no correction) and the firmware says so.
+
+#include <cstdint>
+
+#include "firmware/estimator_health.hpp"
+
+namespace hrg::fw::app {
+
+enum class CalibrationSource : uint8_t {
+  none,    // no calibration (the identity)
+  file,    // given at start: a file, or the built-in constant on bare metal
+  online,  // the firmware's own pickoff self-calibration
+  can,     // a CAN calibration block
+};
+const char* to_string(CalibrationSource s);
+
+enum class CalibrationVerdict : uint8_t {
+  none,       // nothing to judge (the identity is in force)
+  on_trial,   // in force, no check window has judged it yet
+  confirmed,  // a check window agreed
+  withdrawn,  // a check window disagreed: taken out of the chain
+};
+const char* to_string(CalibrationVerdict v);
+
+struct CalibrationStatus {
+  CalibrationSource source = CalibrationSource::none;
+  CalibrationVerdict verdict = CalibrationVerdict::none;
+  uint32_t crc32 = 0;          // of the calibration judged (calibration_crc)
+  double applied_s = 0.0;      // time it was put in force
+  double misfit_before = 0.0;  // last check misfit before it (0: no check before)
+  double misfit_after = 0.0;   // the check that judged it
+  double judged_s = 0.0;       // time of that check
+  uint32_t withdrawals = 0;    // calibrations withdrawn since start
+};
+
+class CalibrationGuard {
+ public:
+  explicit CalibrationGuard(double max_misfit) : max_misfit_(max_misfit) {}
+
+  // A calibration is now in force (`identity`: nothing to judge). `h` is the
+  // estimator's health at that instant, `checking`: its check windows count
+  // (the campaign is over).
+  void applied(CalibrationSource source, uint32_t crc32, bool identity, double t_s,
+               const EstimatorHealth& h, bool checking);
+  // Once per frame. True when the calibration in force must be withdrawn now.
+  bool judge(const EstimatorHealth& h, bool checking, double t_s);
+
+  const CalibrationStatus& status() const { return status_; }
+
+ private:
+  double max_misfit_;
+  CalibrationStatus status_{};
+  uint32_t checks_seen_ = 0;
+  bool was_checking_ = false;
+};
+
+}  // namespace hrg::fw::app

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+#include "firmware/app/calibration_guard.hpp"
+
+namespace hrg::fw::app {
+
+const char* to_string(CalibrationSource s) {
+  switch (s) {
+    case CalibrationSource::none: return "none";
+    case CalibrationSource::file: return "file";
+    case CalibrationSource::online: return "online";
+    case CalibrationSource::can: return "can";
+  }
+  return "?";
+}
+
+const char* to_string(CalibrationVerdict v) {
+  switch (v) {
+    case CalibrationVerdict::none: return "none";
+    case CalibrationVerdict::on_trial: return "on_trial";
+    case CalibrationVerdict::confirmed: return "confirmed";
+    case CalibrationVerdict::withdrawn: return "withdrawn";
+  }
+  return "?";
+}
+
+void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool identity, double t_s,
+                               const EstimatorHealth& h, bool checking) {
+  const uint32_t withdrawals = status_.withdrawals;
+  status_ = CalibrationStatus{};
+  status_.withdrawals = withdrawals;
+  status_.source = identity ? CalibrationSource::none : source;
+  status_.verdict = identity ? CalibrationVerdict::none : CalibrationVerdict::on_trial;
+  status_.crc32 = crc32;
+  status_.applied_s = t_s;
+  // A check made before (with the previous correction) is the reference
+  // the new one must not be worse than.
+  status_.misfit_before = checking && h.windows_checked > 0 ? h.window_misfit : 0.0;
+  checks_seen_ = h.windows_checked;
+  was_checking_ = checking;
+}
+
+bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s) {
+  if (status_.verdict != CalibrationVerdict::on_trial) return false;
+  // Windows checked while the campaign runs (against an early model) or
+  // the one that ends it are no verdict: count from the campaign's end.
+  if (!checking || !was_checking_) {
+    checks_seen_ = h.windows_checked;
+    was_checking_ = checking;
+    return false;
+  }
+  if (h.windows_checked == checks_seen_) return false;
+  checks_seen_ = h.windows_checked;
+  const double m = h.window_misfit;
+  status_.misfit_after = m;
+  status_.judged_s = t_s;
+  const bool noise_like = m <= max_misfit_;
+  const bool not_worse = status_.misfit_before > 0.0 && m <= status_.misfit_before;
+  if (noise_like || not_worse) {
+    status_.verdict = CalibrationVerdict::confirmed;
+    return false;
+  }
+  status_.verdict = CalibrationVerdict::withdrawn;
+  ++status_.withdrawals;
+  return true;
+}
+
+}  // namespace hrg::fw::app

@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+// CalibrationGuard: a calibration put in force is judged by the first check
+// window after the campaign, and withdrawn when that one disagrees.
+#include "firmware/app/calibration_guard.hpp"
+
+#include "support/cpputest.hpp"
+
+using hrg::fw::EstimatorHealth;
+using hrg::fw::app::CalibrationGuard;
+using hrg::fw::app::CalibrationSource;
+using hrg::fw::app::CalibrationVerdict;
+
+namespace {
+
+constexpr double kMaxMisfit = 4.0;
+
+EstimatorHealth checked(uint32_t windows, double misfit) {
+  EstimatorHealth h;
+  h.windows_checked = windows;
+  h.window_misfit = misfit;
+  return h;
+}
+
+}  // namespace
+
+TEST_GROUP(CalibrationGuard){};
+
+TEST(CalibrationGuard, TheIdentityIsNotJudged) {
+  CalibrationGuard g(kMaxMisfit);
+  g.applied(CalibrationSource::file, 0, true, 0.0, {}, false);
+  CHECK(g.status().source == CalibrationSource::none);
+  CHECK_FALSE(g.judge(checked(5, 100.0), true, 1.0));
+  CHECK(g.status().verdict == CalibrationVerdict::none);
+}
+
+TEST(CalibrationGuard, CampaignWindowsAreNoVerdictTheFirstCheckAfterIs) {
+  CalibrationGuard g(kMaxMisfit);
+  g.applied(CalibrationSource::file, 7, false, 0.0, {}, false);
+  // Windows checked during the campaign (an early model) and the one that
+  // ends it prove nothing, whatever their misfit.
+  CHECK_FALSE(g.judge(checked(3, 90.0), false, 50.0));
+  CHECK_FALSE(g.judge(checked(4, 90.0), true, 100.0));
+  CHECK(g.status().verdict == CalibrationVerdict::on_trial);
+  // The first check window after the campaign: above the noise, no check
+  // before it to compare with: withdrawn.
+  CHECK_TRUE(g.judge(checked(5, 4.5), true, 120.0));
+  CHECK(g.status().verdict == CalibrationVerdict::withdrawn);
+  DOUBLES_EQUAL(4.5, g.status().misfit_after, 0.0);
+  DOUBLES_EQUAL(120.0, g.status().judged_s, 0.0);
+  CHECK_EQUAL(1u, g.status().withdrawals);
+  // Judged once: nothing more to withdraw.
+  CHECK_FALSE(g.judge(checked(6, 90.0), true, 140.0));
+}
+
+TEST(CalibrationGuard, ACheckWithinTheNoiseConfirms) {
+  CalibrationGuard g(kMaxMisfit);
+  g.applied(CalibrationSource::can, 7, false, 0.0, checked(2, 1.0), true);
+  CHECK_FALSE(g.judge(checked(2, 1.0), true, 1.0));  // no new check yet
+  CHECK_FALSE(g.judge(checked(3, 3.9), true, 2.0));
+  CHECK(g.status().verdict == CalibrationVerdict::confirmed);
+  CHECK(g.status().source == CalibrationSource::can);
+}
+
+TEST(CalibrationGuard, AboveTheNoiseButBetterThanBeforeConfirms) {
+  // Applied mid-run (online), after a check that already disagreed (misfit
+  // 30): a check at 10 is not consistent with the noise but is better than
+  // before: confirmed; at 31 it would have been withdrawn.
+  CalibrationGuard g(kMaxMisfit);
+  g.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
+  DOUBLES_EQUAL(30.0, g.status().misfit_before, 0.0);
+  CHECK_FALSE(g.judge(checked(9, 10.0), true, 220.0));
+  CHECK(g.status().verdict == CalibrationVerdict::confirmed);
+  CalibrationGuard worse(kMaxMisfit);
+  worse.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
+  CHECK_TRUE(worse.judge(checked(9, 31.0), true, 220.0));
+}
