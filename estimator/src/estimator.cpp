@@ -20,9 +20,9 @@ Status Estimator::end_window(bool fold) {
 void Estimator::check_window(const WindowContribution& w) {
   const double var = last_.sigma_hat_v * last_.sigma_hat_v;
   const double dof = w.rows - w.intercepts;
-  if (!comp_.has_model() || !(var > 0.0) || !(dof > 0.0)) return;
+  if (!has_model_ || !(var > 0.0) || !(dof > 0.0)) return;
   // RSS of this window alone at the accepted p: y'y - 2 p'H'y + p'H'H p.
-  const ParamVector& p = comp_.model();
+  const ParamVector& p = model_;
   const ParamVector b = w.info.block<kParams, 1>(0, kParams);
   const ParamMatrix n = w.info.block<kParams, kParams>(0, 0);
   const double rss = w.info(kParams, kParams) - 2.0 * p.dot(b) + p.dot(n * p);
@@ -33,18 +33,12 @@ void Estimator::check_window(const WindowContribution& w) {
 Solution Estimator::solve_and_accept() {
   last_ = ls_.solve(config_.variant);
   if (last_.accepted()) {
-    comp_.set_model(last_.p);
+    model_ = last_.p;
+    has_model_ = true;
     control_.set_model(last_.p);
     pump_.set_model(last_.p);
   }
   return last_;
-}
-
-double Estimator::step_output(double theta_A_rad, double aB_over_aA, double dt_s,
-                              bool excitation_on) {
-  const double d_phi =
-      excitation_on && config_.compensate_control_drift ? d_phi_rad_s(theta_A_rad) : 0.0;
-  return comp_.step(theta_A_rad, aB_over_aA, d_phi, dt_s);
 }
 
 double Estimator::least_covered_theta_rad() const {

@@ -5,6 +5,31 @@
 
 namespace hrg::fw {
 
+namespace {
+
+// The record's values in the estimator's sample types (the estimator does not
+// see dsp/, so the chain's record is translated here and nowhere else).
+est::WaveSample wave_sample(const ChainRecord& s) {
+  return {.t_s = s.t_s,
+          .a_A_v = s.wave.a_A,
+          .a_B_v = s.wave.a_B,
+          .theta_A_rad = s.theta_A_rad,
+          .E_v2 = s.wave.E};
+}
+
+est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s) {
+  return {.t_s = s.t_s,
+          .a_A_v = s.wave.a_A,
+          .a_B_v = s.wave.a_B,
+          .theta_A_rad = s.theta_A_rad,
+          .pump_phase_error_rad = s.pump_phase_error_rad,
+          .quad_force_sin_v_s = s.quad_force_sin_v_s,
+          .quad_force_cos_v_s = s.quad_force_cos_v_s,
+          .pump_v = s.pump_v};
+}
+
+}  // namespace
+
 void EstimatorPort::begin_window(double t_s) {
   (void)est_.begin_window(t_s);
   (void)self_cal_.begin_window();
@@ -25,14 +50,9 @@ void EstimatorPort::restart() {
 }
 
 void EstimatorPort::add_sample(const ChainRecord& s) {
-  est::WaveSample w;
-  w.t_s = s.t_s;
-  w.a_A_v = s.wave.a_A;
-  w.a_B_v = s.wave.a_B;
-  w.theta_A_rad = s.theta_A_rad;
-  w.E_v2 = s.wave.E;
   // Settling samples and sequencing errors are the accumulator's to count;
   // the self-calibration takes the samples the accumulator took.
+  const est::WaveSample w = wave_sample(s);
   if (est_.add_sample(w) == est::Status::ok) (void)self_cal_.add_sample(w);
 }
 
@@ -72,21 +92,12 @@ void EstimatorPort::add_control_sample(const ChainRecord& s) {
   // The D_Phi fits take the identified decay and split as known: before a
   // model is accepted they would fold in a wrong one.
   if (!est_.has_model()) return;
-  est::ControlDriftEstimator::Sample c;
-  c.t_s = s.t_s;
-  c.a_A_v = s.wave.a_A;
-  c.a_B_v = s.wave.a_B;
-  c.theta_A_rad = s.theta_A_rad;
-  c.pump_phase_error_rad = s.pump_phase_error_rad;
-  c.quad_force_sin_v_s = s.quad_force_sin_v_s;
-  c.quad_force_cos_v_s = s.quad_force_cos_v_s;
-  c.pump_v = s.pump_v;
   // Samples are taken every control period in operate; a gap (a window, a
   // commanded pattern move) ends the derivative blocks first.
   if (s.t_s - last_control_t_s_ > kMaxControlGapS) est_.restart_control();
   last_control_t_s_ = s.t_s;
   // A bad sample restarts the estimate (the estimator's rule).
-  (void)est_.add_control_sample(c);
+  (void)est_.add_control_sample(control_sample(s));
 }
 
 double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {

@@ -10,14 +10,7 @@
 #include <sstream>
 #include <vector>
 
-// toml++ 3.3.0 (Debian 12) asserts a precondition in parse_key that a malformed
-// table header ('[[[1]]]', '[\v]') breaks (upstream marzer/tomlplusplus#301).
-// Without the assertion it reports the parse error, which is what a user of
-// any build (Release, sanitizers, fuzzing) must get: its assertions are off.
-#ifndef TOML_ASSERT
-#define TOML_ASSERT(expr) static_cast<void>(0)
-#endif
-#include <toml++/toml.h>
+#include "toml_text/toml_text.hpp"
 
 namespace hrg::sim {
 
@@ -315,43 +308,16 @@ void read_can(Section s, SimConfig& c) {
   s.finish();
 }
 
-// toml++ 3.3.0 (Debian 12) reaches __builtin_unreachable on some non-ASCII
-// code points where it looks for whitespace (upstream marzer/tomlplusplus#295,
-// found by our fuzzer): undefined behaviour, not an error. Every key and value
-// of a scenario is ASCII, so a non-ASCII byte is refused before parsing.
-void require_ascii(std::string_view text, const std::string& source) {
-  std::size_t line = 1, column = 1;
-  for (const char ch : text) {
-    const auto byte = static_cast<unsigned char>(ch);
-    if (byte >= 0x80) {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "0x%02x", byte);
-      throw ScenarioError(source + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                          ": non-ASCII byte " + hex +
-                          ": scenario files are ASCII, comments included (write deg, degC, uV)");
-    }
-    if (ch == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-}
-
 }  // namespace
 
-SimConfig parse_scenario(std::string_view toml_text, const std::string& source,
+SimConfig parse_scenario(std::string_view text, const std::string& source,
                          const std::string& base_dir) {
-  require_ascii(toml_text, source);
   toml::table root;
   try {
-    root = toml::parse(toml_text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream msg;
-    msg << source << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
-        << e.description();
-    throw ScenarioError(msg.str());
+    root = toml_text::parse(text, source,
+                            "scenario files are ASCII, comments included (write deg, degC, uV)");
+  } catch (const toml_text::TextError& e) {
+    throw ScenarioError(e.what());
   }
   SimConfig c;
   Section top(&root, "", source);

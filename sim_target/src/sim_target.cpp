@@ -283,15 +283,4 @@ Status SimTarget::SimClock::sleep_until_ns(uint64_t t_ns) {
   return t_ns < now_ns() ? Status::timeout : Status::ok;
 }
 
-SimTarget& target() {
-  static SimTarget instance;
-  return instance;
-}
-
 }  // namespace hrg::sim
-
-namespace hrg::hal {
-
-Board& board() { return sim::target().board(); }
-
-}  // namespace hrg::hal

@@ -65,7 +65,6 @@ HourResult run_hour(uint64_t seed, bool verbose, double forgetting_time_s = 0.0)
   m.set_drive(off);
 
   Estimator::Config cfg;
-  cfg.angular_gain = K;
   cfg.ls.forgetting_time_s = forgetting_time_s;
   Estimator est{cfg};
   std::mt19937_64 rng(seed);

@@ -127,18 +127,17 @@ TEST(ControlDrift, Equation23FromThePumpPhaseErrorAndQuadratureEffort) {
   DOUBLES_EQUAL(0.0, ideal.d_phi_rad_s(), 1e-12);
 }
 
-TEST(ControlDrift, EstimatorFacadeAddsDPhiOnlyWithExcitationOn) {
+TEST(ControlDrift, EstimatorFacadeGivesNoDriftBeforeAModel) {
   Estimator::Config cfg;
   Estimator est{cfg};
-  // No model yet: no correction at all.
-  est.step_output(0.2, 0.0, 1e-3, true);
-  DOUBLES_EQUAL(0.0, est.correction_rad(), 0.0);
+  // No model yet: no drift at all.
   DOUBLES_EQUAL(0.0, est.drift_rate_rad_s(0.2, 0.0), 0.0);
+  DOUBLES_EQUAL(0.0, est.d_phi_rad_s(0.2), 0.0);
   const double th = est.least_covered_theta_rad();
   CHECK(th >= 0 && th < M_PI / 2);
 }
 
-TEST(ControlDrift, EstimatorCompensatesDPhiWithExcitationOnOnly) {
+TEST(ControlDrift, EstimatorDriftAndDPhiIntegrateToTheirCorrections) {
   // GIVEN an estimator with an accepted model (16 noise-free windows)
   const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
   SyntheticDecay gen{p, 0.554, 0.0};
@@ -166,16 +165,19 @@ TEST(ControlDrift, EstimatorCompensatesDPhiWithExcitationOnOnly) {
     est.add_control_sample({200.0 + i * 1e-3, 1.0, 0.0, th, 0.0, -g, qc});
   }
   DOUBLES_EQUAL(-qc, est.d_phi_rad_s(th), 1e-3 * qc);
-  // WHEN the output is stepped for 1 s with and without excitation
+  // WHEN the output's integrator (the firmware's AngleOutput uses this one)
+  // takes D = D_nu + D_w + D_Phi for 1 s (excitation on), then D_nu + D_w
+  // for 1 s (excitation off: the firmware leaves D_Phi out)
   const double dnu_rate = est.drift_rate_rad_s(th, 0.0) / 0.554;
-  const double c0 = est.correction_rad();
+  DriftCompensator out{0.554};
   for (int i = 0; i < 1000; ++i)
-    est.step_output(th, 0.0, 1e-3, true);
-  const double with_exc = est.correction_rad() - c0;
+    out.integrate(est.drift_rate_rad_s(th, 0.0) + est.d_phi_rad_s(th), 1e-3);
+  const double with_exc = out.correction_rad();
   for (int i = 0; i < 1000; ++i)
-    est.step_output(th, 0.0, 1e-3, false);
-  const double without = est.correction_rad() - c0 - with_exc;
-  // THEN D_Phi/K adds to the resonator drift only while the excitation is on
+    out.integrate(est.drift_rate_rad_s(th, 0.0), 1e-3);
+  const double without = out.correction_rad() - with_exc;
+  // THEN the corrections are the rates / K times 1 s (the trapezoid of the
+  // step between the two adds half a period of D_Phi/K)
   DOUBLES_EQUAL((dnu_rate - qc / 0.554) * 1.0, with_exc, 1e-3 * qc);
   DOUBLES_EQUAL(dnu_rate * 1.0, without, 1e-3 * qc + 0.5e-3 * qc / 0.554);
 }

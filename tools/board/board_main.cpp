@@ -1,9 +1,14 @@
 // SPDX-License-Identifier: MIT
-// hrg-board: the firmware on the Linux board target in real time, with the
-// simulated converters of sim_target behind the ADC/DAC seam (no hardware
-// needed) and real SocketCAN, libgpiod lines and CLOCK_MONOTONIC.
+// hrg-board: the firmware (firmware/app) in real time on hrg::hal::board() of
+// the Linux target (hrg_board_linux, chosen at link time): SocketCAN, libgpiod
+// lines, CLOCK_MONOTONIC and, with --converters board, the IIO sample streams.
+// By default the simulated converters of sim_target stand behind the ADC/DAC
+// seam instead (no converter hardware needed).
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
-//             [--calibration FILE] [--cal-secret HEX] [--lockstep]
+//             [--calibration FILE] [--converters sim|board] [--cal-secret HEX] [--lockstep]
+// The options set the board's environment (HRG_CAN_IF, HRG_GPIO_CHIP,
+// HRG_EXC_LINE, HRG_FAULT_LINE; the rest as hal/linux/board_linux.hpp says).
+// Without a GPIO chip (option or HRG_GPIO_CHIP) the simulated lines are used.
 // The firmware sends its telemetry on IF at the default rates, answers the
 // commands of the DBC and restarts the controller after 100 ms of bus-off, all
 // through its own CAN link (receive filter set at start). Runs until
@@ -33,10 +38,9 @@
 #include "can/calibration_sender.hpp"
 #include "firmware/app/firmware.hpp"
 #include "firmware/calibration_file.hpp"
-#include "hal/linux/gpiod_line.hpp"
-#include "hal/linux/linux_clock.hpp"
+#include "hal/board.hpp"
+#include "hal/linux/board_linux.hpp"
 #include "hal/linux/realtime.hpp"
-#include "hal/linux/socket_can.hpp"
 #include "sim_target/control.hpp"
 #include "sim_tools/job.hpp"
 
@@ -49,12 +53,9 @@ volatile std::sig_atomic_t g_stop = 0;
 void on_stop(int) { g_stop = 1; }
 
 struct Options {
-  std::string can = "can0";
-  std::string gpio_chip;  // empty: the simulated lines
-  unsigned exc_line = 0;
-  unsigned fault_line = 1;
   double seconds = 1e9;
-  std::string calibration;  // empty: the identity
+  std::string calibration;        // empty: the identity
+  bool board_converters = false;  // false: the simulated converters
   fw::can::CalSecret cal_secret{};
   bool lockstep = false;
 };
@@ -62,10 +63,13 @@ struct Options {
 int usage() {
   std::fprintf(stderr,
                "usage: hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] "
-               "[--seconds S] [--calibration FILE] [--cal-secret HEX] [--lockstep]\n");
+               "[--seconds S] [--calibration FILE] [--converters sim|board] [--cal-secret HEX] "
+               "[--lockstep]\n");
   return 2;
 }
 
+// The board's devices are named in its environment (board_linux.hpp); the
+// options set it before the first hal::board() call opens them.
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -76,19 +80,22 @@ bool parse(int argc, char** argv, Options& o) {
     if (i + 1 >= argc) return false;
     const char* v = argv[++i];
     if (a == "--can") {
-      o.can = v;
+      setenv("HRG_CAN_IF", v, 1);
     } else if (a == "--gpio-chip") {
-      o.gpio_chip = v;
+      setenv("HRG_GPIO_CHIP", v, 1);
     } else if (a == "--exc-line") {
-      o.exc_line = static_cast<unsigned>(std::atoi(v));
+      setenv("HRG_EXC_LINE", v, 1);
     } else if (a == "--fault-line") {
-      o.fault_line = static_cast<unsigned>(std::atoi(v));
+      setenv("HRG_FAULT_LINE", v, 1);
     } else if (a == "--seconds") {
       o.seconds = std::atof(v);
     } else if (a == "--calibration") {
       o.calibration = v;
     } else if (a == "--cal-secret") {
       if (!can::parse_secret(v, o.cal_secret)) return false;
+    } else if (a == "--converters" &&
+               (std::strcmp(v, "sim") == 0 || std::strcmp(v, "board") == 0)) {
+      o.board_converters = std::strcmp(v, "board") == 0;
     } else {
       return false;
     }
@@ -131,6 +138,43 @@ class LabTable {
   uint8_t seq_ = 0;
 };
 
+const char* env_or(const char* name, const char* fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr && *v != '\0' ? v : fallback;
+}
+
+// The board of the firmware: CAN and clock of the Linux board; its lines when
+// a GPIO chip is named, else the simulation's; its converters or the
+// simulation's; in lockstep the simulated converters' clock paces. nullptr (after saying why) when
+// a device asked for is closed.
+std::unique_ptr<hal::Board> assemble_board(const Options& o, hal::Board& sim) {
+  hal::Board& hw = hal::board();
+  const lb::BoardOpenStatus st = lb::board_open_status();
+  if (st.can != hal::Status::ok) {
+    std::fprintf(stderr, "hrg-board: cannot open CAN interface %s: %s\n",
+                 env_or("HRG_CAN_IF", "can0"), hal::to_string(st.can));
+    return nullptr;
+  }
+  const bool board_lines = std::getenv("HRG_GPIO_CHIP") != nullptr;
+  if (board_lines && (st.excitation != hal::Status::ok || st.fault != hal::Status::ok)) {
+    std::fprintf(stderr, "hrg-board: GPIO lines %s/%s on %s: %s/%s\n", env_or("HRG_EXC_LINE", "0"),
+                 env_or("HRG_FAULT_LINE", "1"), env_or("HRG_GPIO_CHIP", ""),
+                 hal::to_string(st.excitation), hal::to_string(st.fault));
+    return nullptr;
+  }
+  if (o.board_converters && (st.adc != hal::Status::ok || st.dac != hal::Status::ok)) {
+    std::fprintf(
+        stderr, "hrg-board: converters %s/%s: %s/%s\n", env_or("HRG_ADC_DEV", "/dev/iio:device0"),
+        env_or("HRG_DAC_DEV", "/dev/iio:device1"), hal::to_string(st.adc), hal::to_string(st.dac));
+    return nullptr;
+  }
+  const hal::Board& conv = o.board_converters ? hw : sim;
+  const hal::Board& lines = board_lines ? hw : sim;
+  return std::make_unique<hal::Board>(hal::Board{conv.adc, conv.dac, lines.excitation_enable,
+                                                 lines.fault_input, hw.can,
+                                                 o.lockstep ? sim.clock : hw.clock});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -147,47 +191,21 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  sim::SimTarget& sim = sim::target();
-  sim.configure(job.sim);
-  hal::Board& sim_board = sim.board();
-
-  lb::SocketCan can;
-  if (const hal::Status s = can.open(o.can.c_str()); s != hal::Status::ok) {
-    std::fprintf(stderr, "hrg-board: cannot open CAN interface %s: %s\n", o.can.c_str(),
-                 hal::to_string(s));
-    return 1;
-  }
-  lb::GpiodOutput exc_line;
-  lb::GpiodInput fault_line;
-  hal::DigitalOut* exc = &sim_board.excitation_enable;
-  hal::DigitalIn* fault = &sim_board.fault_input;
-  if (!o.gpio_chip.empty()) {
-    lb::LineConfig lc;
-    lc.chip = o.gpio_chip.c_str();
-    lc.offset = o.exc_line;
-    const hal::Status se = exc_line.open(lc);
-    lc.offset = o.fault_line;
-    const hal::Status sf = fault_line.open(lc);
-    if (se != hal::Status::ok || sf != hal::Status::ok) {
-      std::fprintf(stderr, "hrg-board: GPIO lines %u/%u on %s: %s/%s\n", o.exc_line, o.fault_line,
-                   lc.chip, hal::to_string(se), hal::to_string(sf));
-      return 1;
-    }
-    exc = &exc_line;
-    fault = &fault_line;
-  }
-  lb::LinuxClock clock;
-  // In lockstep the simulated converters' clock paces, the host's times the tasks.
-  hal::Board board{sim_board.adc, sim_board.dac, *exc,
-                   *fault,        can,           o.lockstep ? sim_board.clock : clock};
+  // The simulation's converters and lines (unused when the board's serve).
+  auto sim = std::make_unique<sim::SimTarget>();
+  sim->configure(job.sim);
+  const std::unique_ptr<hal::Board> board = assemble_board(o, sim->board());
+  if (!board) return 1;
 
   if (!o.lockstep) {
     char rt[200];
     std::printf("hrg-board: %s\n", lb::describe(lb::setup_realtime({}), rt, sizeof rt));
   }
-  // Large (the chain holds its filters): allocated once, before the loop.
+  // Large (the chain holds its filters): allocated once, before the loop. The
+  // host's clock times the tasks, in lockstep too.
   auto firmware = std::make_unique<fw::app::Firmware>(
-      board, clock, o.lockstep ? fw::Pacing::lockstep : fw::Pacing::real_time, job.firmware);
+      *board, hal::board().clock, o.lockstep ? fw::Pacing::lockstep : fw::Pacing::real_time,
+      job.firmware);
   if (const char* err = firmware->error()) {
     std::fprintf(stderr, "hrg-board: %s\n", err);
     return 1;
@@ -201,22 +219,22 @@ int main(int argc, char** argv) {
   uint64_t k = 0;
   int exc_edges = 0;
   bool last_exc = false;
-  LabTable lab(sim);
+  LabTable lab(*sim);
   for (; k < frames && g_stop == 0; ++k) {
-    lab.before_frame(k, can);
+    lab.before_frame(k, board->can);
     gyro->run_frame();
-    lab.after_frame(sim);
+    lab.after_frame(*sim);
     const fw::GyroStatus& st = gyro->status();
     if (st.enable_line != last_exc) ++exc_edges;
     last_exc = st.enable_line;
   }
   const auto& fs = gyro->executive().frame_stats();
-  const auto c = can.counters();
+  const auto c = board->can.counters();
   std::printf(
       "hrg-board: %.3f s on %s: %llu frames, %u deadline misses, %u missed frames, max frame "
       "%.3f ms; mode %d, faults 0x%04x; excitation edges %d; commands %u accepted %u refused; "
       "CAN tx %u, refused %u, tx_queue_full %u, bus-off %u, restarts %u\n",
-      static_cast<double>(k) / fw::kBaseRateHz, o.can.c_str(),
+      static_cast<double>(k) / fw::kBaseRateHz, env_or("HRG_CAN_IF", "can0"),
       static_cast<unsigned long long>(fs.frames), fs.deadline_misses, fs.missed_frames,
       fs.max_frame_ns * 1e-6, static_cast<int>(gyro->status().mode), gyro->status().faults,
       exc_edges, gyro->commands_accepted(), gyro->commands_refused(), c.tx_frames,

@@ -8,9 +8,10 @@
 //   free_decay left:        end_window()           -> window folded into the LS
 //   free_decay aborted:     abort_window()         -> window dropped
 //   at a slow rate (e.g. after each window):  solve_and_accept()
-//   each 1 kHz tick:        step_output(theta_A, a_B/a_A, dt, excitation_on)
-//                           -> angle correction (input-axis rad) to add to
-//                              -2 (theta_A - theta_A0) / K
+//   each 1 kHz tick:        drift_rate_rad_s(theta_A, a_B/a_A) (+ d_phi_rad_s(theta_A)
+//                           with the excitation on) is the drift D whose
+//                           integral / K the output adds to -2 (theta_A - theta_A0) / K
+//                           (the firmware's AngleOutput, by DriftCompensator::integrate)
 //   with excitation on:     add_control_sample(...) feeds the D_Phi estimates
 //                           (pump phase error eps = pi/2 - 2 (phi_V - phi_A), pump
 //                           amplitude V0, quadrature forcer parts)
@@ -29,22 +30,15 @@ namespace hrg::est {
 class Estimator {
  public:
   struct Config {
-    double angular_gain = 0.554;  // K
     Variant variant = Variant::joint;
     WindowAccumulator::Config window{};
     NormalEquations::Config ls{};
     ControlDriftEstimator::Config control{};
     PumpDriftEstimator::Config pump{};
-    bool compensate_control_drift = true;
   };
 
   explicit Estimator(const Config& c)
-      : config_(c),
-        window_(c.window),
-        ls_(c.ls),
-        comp_(c.angular_gain),
-        control_(c.control),
-        pump_(c.pump) {}
+      : config_(c), window_(c.window), ls_(c.ls), control_(c.control), pump_(c.pump) {}
 
   Status begin_window(double t_switch_s) {
     // The excitation-on segment of the pump fit ends here.
@@ -67,10 +61,8 @@ class Estimator {
 
   // D_nu + D_w (eqs. 6/7/22, drift.hpp) with the accepted model, rad/s ("Omega K" units).
   double drift_rate_rad_s(double theta_A_rad, double aB_over_aA) const {
-    return comp_.has_model() ? resonator_drift_rad_s(comp_.model(), theta_A_rad, aB_over_aA) : 0.0;
+    return has_model_ ? resonator_drift_rad_s(model_, theta_A_rad, aB_over_aA) : 0.0;
   }
-  // Control-rate output correction; D_Phi is added only with excitation on.
-  double step_output(double theta_A_rad, double aB_over_aA, double dt_s, bool excitation_on);
   // Feeds both D_Phi estimators (eq. 23 and the pump's gap part); false if
   // either refused the sample (it then restarts).
   bool add_control_sample(const ControlDriftEstimator::Sample& s) {
@@ -85,7 +77,7 @@ class Estimator {
     pump_.restart();
   }
 
-  bool has_model() const { return comp_.has_model(); }
+  bool has_model() const { return has_model_; }
   // The model check on each window folded while a model is in force: the
   // window's own residual sum of squares against the accepted model, per
   // degree of freedom, over the accepted fit's residual variance (1 when
@@ -94,9 +86,8 @@ class Estimator {
   // 0 until a window has been checked.
   double last_window_misfit() const { return last_misfit_; }
   uint32_t windows_checked() const { return windows_checked_; }
-  const ParamVector& model() const { return comp_.model(); }
+  const ParamVector& model() const { return model_; }
   const Solution& last_solution() const { return last_; }
-  double correction_rad() const { return comp_.correction_rad(); }
   // D_Phi at pattern angle theta (eq. 23 part + ring-pump gap part), rad/s.
   double d_phi_rad_s(double theta_A_rad) const {
     return (control_.valid() ? control_.d_phi_rad_s() : 0.0) +
@@ -115,7 +106,8 @@ class Estimator {
   Config config_;
   WindowAccumulator window_;
   NormalEquations ls_;
-  DriftCompensator comp_;
+  ParamVector model_ = ParamVector::Zero();  // the accepted model
+  bool has_model_ = false;
   ControlDriftEstimator control_;
   PumpDriftEstimator pump_;
   void check_window(const WindowContribution& w);

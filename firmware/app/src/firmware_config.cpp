@@ -58,7 +58,6 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
   cfg.chain = chain_config_for(conv, cfg.chain);
   cfg.chain.amplitude_setpoint_v = cfg.gyro.amplitude_set_v;
   cfg.gyro.monitor.amplitude_set_v = cfg.gyro.amplitude_set_v;
-  cfg.estimator.angular_gain = cfg.gyro.angular_gain;
   cfg.gyro.envelope = envelope_reference_config(cfg.chain, conv);
 }
 

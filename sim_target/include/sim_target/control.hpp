@@ -178,7 +178,8 @@ class SimTarget {
   std::array<double, 2 * kChunk> noise_buf_{};
 };
 
-// The instance behind hrg::hal::board() (configured with SimConfig{} on first use).
+// The instance behind hrg::hal::board() (configured with SimConfig{} on first
+// use); defined in hrg_board_sim, the simulated target chosen at link time.
 SimTarget& target();
 
 }  // namespace hrg::sim

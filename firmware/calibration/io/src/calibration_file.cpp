@@ -6,14 +6,7 @@
 #include <numbers>
 #include <sstream>
 
-// toml++ 3.3.0 (Debian 12) asserts a precondition that a malformed table
-// header breaks (upstream marzer/tomlplusplus#301) and misreads some
-// non-ASCII code points (#295): as in the scenario reader, its assertions are
-// off in every build (the parse error is reported) and the text must be ASCII.
-#ifndef TOML_ASSERT
-#define TOML_ASSERT(expr) static_cast<void>(0)
-#endif
-#include <toml++/toml.h>
+#include "toml_text/toml_text.hpp"
 
 namespace hrg::fw {
 
@@ -114,25 +107,12 @@ double calibration_file_to_si(std::size_t field) {
   return is_angle(field) ? std::numbers::pi / 180.0 : 1.0;
 }
 
-CalibrationFile parse_calibration(std::string_view toml_text, const std::string& source) {
-  std::size_t line = 1, column = 1;
-  for (const char ch : toml_text) {
-    if (static_cast<unsigned char>(ch) >= 0x80) {
-      throw CalibrationFileError(
-          source + ":" + std::to_string(line) + ":" + std::to_string(column) +
-          ": non-ASCII byte: calibration files are ASCII, comments included");
-    }
-    line += ch == '\n' ? 1 : 0;
-    column = ch == '\n' ? 1 : column + 1;
-  }
+CalibrationFile parse_calibration(std::string_view text, const std::string& source) {
   toml::table root;
   try {
-    root = toml::parse(toml_text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream msg;
-    msg << source << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
-        << e.description();
-    throw CalibrationFileError(msg.str());
+    root = toml_text::parse(text, source, "calibration files are ASCII, comments included");
+  } catch (const toml_text::TextError& e) {
+    throw CalibrationFileError(e.what());
   }
   check_format(root, source);
   CalibrationFile out;

@@ -7,7 +7,7 @@
 namespace hrg::hal::linux_board {
 
 // The Linux board behind hrg::hal::board() when a program links
-// hrg_board_linux (instead of hrg_sim_target). Devices are opened on the first
+// hrg_board_linux (instead of hrg_board_sim). Devices are opened on the first
 // call to board(), from the environment:
 //   HRG_CAN_IF            CAN interface                  (can0)
 //   HRG_GPIO_CHIP         chip of the two lines          (gpiochip0)
