@@ -36,6 +36,19 @@ void bias_json(JsonWriter& w, const char* key, const BiasFit& f) {
 }
 }  // namespace
 
+std::string bias_test_coverage(const JobResult& r) {
+  std::string s =
+      fmt("the compensated bias is measured on %zu of %zu parks (those with the model "
+          "valid throughout",
+          r.parks_model_valid, r.parks.size());
+  s += r.t_model_valid_s >= 0.0 ? fmt("; valid from %.1f s)", r.t_model_valid_s)
+                                : std::string("; the model was never valid)");
+  if (r.bias_test_needs_s > 0.0)
+    s += fmt("; this resonator needs a run of at least %.0f s (--duration %.0f)",
+             r.bias_test_needs_s, r.bias_test_needs_s);
+  return s;
+}
+
 bool judge(const JobConfig& job, JobResult& r) {
   r.failures.clear();
   if (!r.reached_operate) r.failures.push_back("the gyro never reached operate");
@@ -64,6 +77,11 @@ bool judge(const JobConfig& job, JobResult& r) {
             "with the model (last misfit %.1f); the output is the raw angle",
             r.model_checks_failed, r.last_window_misfit));
   }
+  if (!job.parks.empty() && !r.fit_comp.ok) {
+    // Too few parks with the model valid to fit: the compensation is not
+    // measured (not "no better than raw"), and the length it needs is said.
+    r.failures.push_back(bias_test_coverage(r));
+  }
   if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
       r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
     r.failures.push_back(
@@ -82,6 +100,9 @@ void drift_json(JsonWriter& w, const JobResult& r) {
   bias_json(w, "compensated", r.fit_comp);
   bias_json(w, "model", r.fit_model);
   w.integer("parked_angles", static_cast<long long>(r.parks.size()));
+  w.integer("parks_model_valid", static_cast<long long>(r.parks_model_valid));
+  w.number("t_model_valid_s", r.t_model_valid_s);
+  w.number("bias_test_needs_s", r.bias_test_needs_s);
   w.number("control_drift_mean_dph", r.control_drift_mean_dph);
   w.begin_array("parks");
   for (const auto& p : r.parks) {
@@ -90,6 +111,7 @@ void drift_json(JsonWriter& w, const JobResult& r) {
     w.number("raw_dph", p.bias_raw_dph);
     w.number("compensated_dph", p.bias_comp_dph);
     w.number("model_dph", p.bias_model_dph);
+    w.boolean("model_valid", p.model_valid);
     w.end_object();
   }
   w.end_array();
@@ -376,9 +398,12 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   add("raw", r.fit_raw);
   add("compensated", r.fit_comp);
   add("drift model (truth)", r.fit_model);
-  bias.row({"parked angles", fmt("%zu", r.parks.size())});
+  bias.row({"parked angles", fmt("%zu (compensated fit over the %zu with the model valid)",
+                                 r.parks.size(), r.parks_model_valid)});
   bias.row({"control-loop drift", fmt("%+.3f", r.control_drift_mean_dph), "(mean D_Phi/K added)"});
   bias.print(out);
+  if (r.parks_model_valid < r.parks.size())
+    std::fprintf(out, "  bias test: %s\n", bias_test_coverage(r).c_str());
 
   TextTable ex(r.real_time ? "executive (real time: " + r.realtime_setup + ")"
                            : std::string("executive (lockstep; host time per task)"));

@@ -100,6 +100,9 @@ struct ParkResult {
   double bias_raw_dph = 0.0;    // slope of (raw output - true angle), input-rate units
   double bias_comp_dph = 0.0;   // same with the drift compensation
   double bias_model_dph = 0.0;  // the true D/K at that angle (what the model predicts)
+  // The firmware reported its compensation valid over the whole park; the
+  // compensated fit takes only such parks.
+  bool model_valid = false;
 };
 
 struct TaskFigures {
@@ -151,6 +154,13 @@ struct JobResult {
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
+  // The bias test against the firmware's own word: parks with the model
+  // valid throughout (fit_comp is over these only), when it first became
+  // valid, and the run length the resonator needs for every park to be
+  // measured with it (0 when this run was long enough).
+  std::size_t parks_model_valid = 0;
+  double t_model_valid_s = -1.0;
+  double bias_test_needs_s = 0.0;
   std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
   double allan_span_s = 0.0;      // length of the still stretch it was computed on
   double tracking_rms_deg = 0.0;  // compensated output - true, after operate

@@ -28,6 +28,10 @@ void write_allan_csv(const std::filesystem::path& path, const JobResult& r);
 // The end-of-run summary table.
 void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r);
 
+// How many parks the compensated bias was measured on (the model valid
+// throughout), since when, and the run length the resonator needs.
+std::string bias_test_coverage(const JobResult& r);
+
 // Fills r.failures with what makes the run a failure (see the checks in
 // report_json); returns true when the run passed.
 bool judge(const JobConfig& job, JobResult& r);
