@@ -189,8 +189,8 @@ class PumpDriftEstimator {
   };
   using Sample = ControlDriftEstimator::Sample;
 
-  PumpDriftEstimator() = default;
-  explicit PumpDriftEstimator(const Config& c) : config_(c) {}
+  PumpDriftEstimator() { batch_.fill(Mat4::Zero()); }
+  explicit PumpDriftEstimator(const Config& c) : config_(c) { batch_.fill(Mat4::Zero()); }
 
   void set_model(const ParamVector& p) { p_ = p; }
   // One control-rate sample with the excitation on (pump_v > 0). Bad input
@@ -230,9 +230,9 @@ class PumpDriftEstimator {
 
   Config config_{};
   ParamVector p_ = ParamVector::Zero();
-  Mat4 m_ = Mat4::Zero();               // [N b; b' yy] over folded segments
-  std::array<Mat4, kBatches> batch_{};  // the same sums over segments n, n + kBatches, ...
-  uint32_t segments_{0};                // segments folded
+  Mat4 m_ = Mat4::Zero();             // [N b; b' yy] over folded segments
+  std::array<Mat4, kBatches> batch_;  // the same sums over segments n, n + kBatches, ...
+  uint32_t segments_{0};              // segments folded
   double fit_s_{0};
   double t_last_fold_s_{0};
   bool have_fold_{false};
