@@ -28,6 +28,23 @@ namespace hrg::est {
 
 class Estimator {
  public:
+  // Forgetting derived from how fast the parameters are seen to move (used
+  // when NormalEquations::Config::forgetting_time_s is 0, i.e. not set).
+  // Each accepted solve is compared with an anchor solution; a parameter
+  // that moved more than `move_sigmas` standard errors of the difference
+  // (nested fits: C_anchor - C_now) sets the memory that balances the lag
+  // of a drift at the seen rate r against the noise, tau = (s^2 / 2r^2)^(1/3)
+  // with s^2 the variance of the parameter times the data's span, and the
+  // anchor moves on. Nothing seen: no forgetting (the model keeps
+  // converging as 1/sqrt(T)); a memory in force lengthens to the span over
+  // which nothing moved.
+  struct Forgetting {
+    bool adaptive = true;
+    double move_sigmas = 4.5;  // 5 parameters, ~350 solves a day: ~1 % false alarm
+    double min_s = 3000.0;     // memory floor (the windows must cover the 4 theta bins in it)
+    double min_windows = 16;   // the anchor is taken once the fit holds this many windows
+  };
+
   struct Config {
     double angular_gain = 0.554;  // K
     Variant variant = Variant::joint;
@@ -36,6 +53,7 @@ class Estimator {
     ControlDriftEstimator::Config control{};
     PumpDriftEstimator::Config pump{};
     bool compensate_control_drift = true;
+    Forgetting forgetting{};
   };
 
   explicit Estimator(const Config& c)
@@ -111,6 +129,8 @@ class Estimator {
   double least_covered_theta_rad() const;
   ParamMatrix cramer_rao_bound(double sigma_v) const { return ls_.cramer_rao_bound(sigma_v); }
   const NormalEquations& normal_equations() const { return ls_; }
+  // Memory of the normal equations now (s, 0: none), configured or derived.
+  double forgetting_time_s() const { return ls_.config().forgetting_time_s; }
   const WindowAccumulator& window() const { return window_; }
 
  private:
@@ -121,6 +141,12 @@ class Estimator {
   ControlDriftEstimator control_;
   PumpDriftEstimator pump_;
   void check_window(const WindowContribution& w);
+  void update_forgetting(const Solution& s);
+  Solution anchor_{};
+  double t_anchor_s_ = 0.0;
+  bool have_anchor_ = false;
+  double t_first_window_s_ = -1.0;
+  double t_last_window_s_ = 0.0;
   WindowContribution scratch_{};
   Solution last_{};
   double last_misfit_ = 0.0;

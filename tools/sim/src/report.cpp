@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "sim_tools/report.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <fstream>
+#include <memory>
+#include <numbers>
 #include <stdexcept>
 
 #include "recording/recording_writer.hpp"
@@ -304,16 +306,41 @@ std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobCon
 
 }  // namespace
 
-void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r) {
+std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& path,
+                                                   const JobConfig& job, const JobResult& r,
+                                                   const TelemetryFileOptions& o) {
   // Streamed row by row: an hour of telemetry is not held twice in memory.
-  recording::RecordingWriter wr(path, telemetry_columns(), job.firmware.chain.f_center_hz,
-                                job.firmware.gyro.angular_gain, telemetry_metadata(job));
+  std::vector<std::filesystem::path> files;
+  auto meta = telemetry_metadata(job);
+  const std::size_t every = o.decimate > 1 ? o.decimate : 1;
+  if (every > 1)
+    meta.emplace_back("decimation", fmt("every %zu-th row of %.0f Hz", every, job.telemetry_hz));
+  const auto file_for = [&](std::size_t part) {
+    if (!(o.rotate_s > 0.0)) return path;
+    std::filesystem::path p = path;
+    p.replace_filename(path.stem().string() + fmt("-%03zu", part) + path.extension().string());
+    return p;
+  };
+  std::unique_ptr<recording::RecordingWriter> wr;
+  std::size_t part = 0;
   std::vector<double> v;
-  for (const TelemetryRow& row : r.rows) {
+  for (std::size_t i = 0; i < r.rows.size(); i += every) {
+    const TelemetryRow& row = r.rows[i];
+    const std::size_t part_now =
+        o.rotate_s > 0.0 ? static_cast<std::size_t>(std::max(row.t_s, 0.0) / o.rotate_s) : 0;
+    if (!wr || part_now != part) {
+      if (wr) wr->close();
+      part = part_now;
+      files.push_back(file_for(part));
+      wr = std::make_unique<recording::RecordingWriter>(files.back(), telemetry_columns(),
+                                                        job.firmware.chain.f_center_hz,
+                                                        job.firmware.gyro.angular_gain, meta);
+    }
     telemetry_values(row, v);
-    wr.write_row(v);
+    wr->write_row(v);
   }
-  wr.close();
+  if (wr) wr->close();
+  return files;
 }
 
 recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r) {
