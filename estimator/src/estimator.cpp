@@ -82,6 +82,12 @@ void Estimator::update_forgetting(const Solution& s) {
     t_anchor_s_ = t;
   } else if (tau_now > 0.0 && span_s > tau_now) {
     ls_.set_forgetting_time_s(span_s);
+  } else if (tau_now == 0.0 &&
+             anchor_.covariance(kDnuC, kDnuC) > 4.0 * s.covariance(kDnuC, kDnuC)) {
+    // The anchor holds under a quarter of the information now: a newer one
+    // (the test compares the new data with the old, both of weight).
+    anchor_ = s;
+    t_anchor_s_ = t;
   }
 }
 
