@@ -54,6 +54,7 @@ void WindowScheduler::open(uint32_t bin, WindowDecision& d) {
   d.open = true;
   in_window_ = true;
   in_window_frames_ = 0;
+  window_length_ = done_ ? operation_length() : cfg_.length_frames;
   window_bin_ = bin;
   since_start_ = 0;
   moving_ = false;
@@ -75,8 +76,8 @@ bool WindowScheduler::operation_window_due(bool is_static) const {
   // Continued identification: as many windows as the duty allows, never
   // closer than the window period.
   if (cfg_.operation_duty <= 0.0 || since_start_ < cfg_.period_frames) return false;
-  const double off_after = static_cast<double>(off_frames_ + cfg_.length_frames);
-  return off_after <= cfg_.operation_duty * static_cast<double>(frames_ + cfg_.length_frames);
+  const double off_after = static_cast<double>(off_frames_ + operation_length());
+  return off_after <= cfg_.operation_duty * static_cast<double>(frames_ + operation_length());
 }
 
 WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
@@ -91,7 +92,7 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
       in_window_ = false;
       return d;
     }
-    if (++in_window_frames_ >= cfg_.length_frames) {
+    if (++in_window_frames_ >= window_length_) {
       in_window_ = false;
       ++counts_[window_bin_];
       ++windows_;

@@ -8,8 +8,9 @@
 // prediction of it for the windows taken (sqrt of the bound's dnu_C, dnu_S
 // variances over K). At the end, the parked-angle test's figures.
 //
-//   bench_sim_day [--hours H] [--thermal] [--forgetting-s S] [--duty D]
+//   bench_sim_day [--hours H] [--thermal] [--forgetting-s S] [--duty D] [--window-s S]
 //
+// --window-s: length of the windows after the campaign (default the plan's 5 s).
 // --thermal: the resonator's damping changes by 0.2 %/degC (thermal_damping)
 // under a +-2 degC sine with one period over the run. About 180 simulated s
 // per CPU s: a 24 h run takes ~8 CPU minutes (run it under nice).
@@ -33,6 +34,7 @@ struct Options {
   bool thermal = false;
   double forgetting_s = 0.0;  // 0: derived by the estimator
   double duty = fw::app::kDefaultOperationDuty;
+  double window_s = 0.0;  // operation windows' length (0: the plan's)
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -44,6 +46,8 @@ bool parse(int argc, char** argv, Options& o) {
       o.hours = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--forgetting-s") == 0 && has_value) {
       o.forgetting_s = std::atof(argv[++i]);
+    } else if (std::strcmp(argv[i], "--window-s") == 0 && has_value) {
+      o.window_s = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--duty") == 0 && has_value) {
       o.duty = std::atof(argv[++i]);
     } else {
@@ -90,6 +94,8 @@ int main(int argc, char** argv) {
   simtools::JobConfig job = simtools::default_job(o.hours * 3600.0, 16);
   job.telemetry_hz = 10.0;  // the analysis needs no more; a day at 100 Hz is 2 GB of rows
   job.firmware.gyro.windows.operation_duty = o.duty;
+  job.firmware.gyro.windows.operation_length_frames =
+      static_cast<uint32_t>(std::lround(o.window_s * fw::kBaseRateHz));
   job.firmware.estimator.ls.forgetting_time_s = o.forgetting_s;
   if (o.thermal) {
     job.sim.effects.thermal_damping.enabled = true;

@@ -259,3 +259,24 @@ TEST(WindowScheduler, ContinuedIdentificationKeepsTheRunsExcitationOffShareAtThe
                 static_cast<double>(c.length_frames) / static_cast<double>(l.s.frames()));
   CHECK(l.opened - before >= 100000 / 500 - 1);
 }
+
+TEST(WindowScheduler, OperationWindowsHaveTheirOwnLength) {
+  // GIVEN 10-frame campaign windows and 30-frame windows in operation
+  WindowConfig c = small_config();
+  c.check_period_frames = 500;
+  c.operation_length_frames = 30;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  for (int f = 0; f < 200; ++f)
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  // THEN the next (check) window stays open 30 frames
+  int opened_at = -1, closed_at = -1;
+  for (int f = 0; f < 1000 && closed_at < 0; ++f) {
+    const WindowDecision d = l.frame(10.0 + 0.05 * f, 2.0, good);
+    if (d.open) opened_at = f;
+    if (d.close) closed_at = f;
+  }
+  CHECK(opened_at >= 0);
+  LONGS_EQUAL(30, closed_at - opened_at);
+}
