@@ -37,7 +37,9 @@ void window(Estimator& est, const ParamVector& p, double t0_s, double theta0_rad
 // scaled by 1 + drift_per_s t (a thermal damping change, say).
 double run_drifting(int count, double drift_per_s) {
   std::mt19937_64 rng(7);
-  Estimator est(Estimator::Config{});
+  Estimator::Config cfg{};
+  cfg.forgetting.adaptive = true;
+  Estimator est(cfg);
   const ParamVector p0 = seed_params(0.26, 0.70);
   for (int k = 0; k < count; ++k) {
     const double t = 50.0 * k;
