@@ -357,9 +357,11 @@ TEST(ControlLoopDrift, TheGapHarmonicsOfThePumpAreCompensated) {
       nu * std::hypot(0.02, 0.01) / 2.0 / j.firmware.gyro.angular_gain * kRadSToDph;
   CHECK(off.fit_comp.ok && on.fit_comp.ok);
   DOUBLES_EQUAL(expected_dph, off.fit_comp.amplitude(), 0.15 * expected_dph);
-  // THEN with D_Phi in the output the compensated ADB drops by at least 40 %
-  // within the 365 s run (the fit converges over the parks).
-  CHECK(on.fit_comp.amplitude() < 0.6 * off.fit_comp.amplitude());
+  // THEN with D_Phi in the output the compensated ADB drops by at least 20 %
+  // within the 365 s run: the pump's part is added only once its gap
+  // harmonic stands 6.5 of its own standard errors from zero (~230 s here;
+  // 12.7 -> 9.2 deg/h), so that an ideal electrode gets nothing added.
+  CHECK(on.fit_comp.amplitude() < 0.8 * off.fit_comp.amplitude());
 }
 
 TEST_GROUP(Lockstep){void setup()

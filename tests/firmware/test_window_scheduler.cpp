@@ -229,3 +229,54 @@ TEST(WindowScheduler, AfterTheCampaignCheckWindowsRunAtTheirPeriodAndOnceTheBase
   LONGS_EQUAL(before + 1, l.opened);
   CHECK(l.s.campaign_done());
 }
+
+TEST(WindowScheduler, ContinuedIdentificationKeepsTheRunsExcitationOffShareAtTheDuty) {
+  // GIVEN a campaign of 16 windows (2 per bin, 160 of ~850 frames off), then
+  // continued identification at 2 % with a rare check (every 20000 frames)
+  WindowConfig c = small_config();
+  c.min_windows_per_bin = 2;
+  c.check_period_frames = 20000;
+  c.operation_duty = 0.02;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  int f = 0;
+  for (; !l.s.campaign_done() && f < 20000; ++f)
+    l.frame(0.01 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  CHECK(l.s.excitation_off_fraction() > 0.1);
+  // THEN no window opens until the run's share has fallen to the duty
+  const uint32_t before = l.opened;
+  const auto due = static_cast<uint64_t>(static_cast<double>(l.s.off_frames()) / c.operation_duty);
+  for (; l.s.frames() + c.length_frames + 1 < due; ++f)
+    l.frame(0.01 * f, 2.0, good);
+  LONGS_EQUAL(before, l.opened);
+  // and from then on it stays at the duty (within one window) over a long
+  // run: 10-frame windows every 500 frames.
+  for (int n = 0; n < 100000; ++n, ++f)
+    l.frame(0.01 * f, 2.0, good);
+  CHECK(l.s.excitation_off_fraction() <= c.operation_duty + 1e-12);
+  DOUBLES_EQUAL(c.operation_duty, l.s.excitation_off_fraction(),
+                static_cast<double>(c.length_frames) / static_cast<double>(l.s.frames()));
+  CHECK(l.opened - before >= 100000 / 500 - 1);
+}
+
+TEST(WindowScheduler, OperationWindowsHaveTheirOwnLength) {
+  // GIVEN 10-frame campaign windows and 30-frame windows in operation
+  WindowConfig c = small_config();
+  c.check_period_frames = 500;
+  c.operation_length_frames = 30;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  for (int f = 0; f < 200; ++f)
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  // THEN the next (check) window stays open 30 frames
+  int opened_at = -1, closed_at = -1;
+  for (int f = 0; f < 1000 && closed_at < 0; ++f) {
+    const WindowDecision d = l.frame(10.0 + 0.05 * f, 2.0, good);
+    if (d.open) opened_at = f;
+    if (d.close) closed_at = f;
+  }
+  CHECK(opened_at >= 0);
+  LONGS_EQUAL(30, closed_at - opened_at);
+}

@@ -26,7 +26,7 @@ constexpr const char* kUsage =
     "usage: hrg sim [--scenario FILE] [--duration S] [--out DIR] [--can-log FILE]\n"
     "               [--bias-angles N] [--static-base] [--real-time] [--no-plots]\n"
     "               [--no-control-drift] [--calibration FILE] [--self-calibrate]\n"
-    "               [--profile] [--quiet]\n\n"
+    "               [--profile] [--quiet] [--telemetry-decimate N] [--telemetry-rotate-s S]\n\n"
     "Runs the firmware against the simulated resonator in lockstep at full rate\n"
     "(100 kHz ADC, 1 kHz base frame) and writes report.json, telemetry.csv,\n"
     "bias.csv, allan.csv and PNG plots into DIR (default: sim-out).\n\n"
@@ -52,6 +52,10 @@ constexpr const char* kUsage =
     "--self-calibrate lets the firmware identify the pickoff gain mismatch and\n"
     "misalignment from its own windows and apply them when the estimate is well\n"
     "conditioned and significant (the identification then starts again).\n"
+    "--telemetry-decimate N writes every N-th telemetry row (100 Hz / N); the\n"
+    "analysis still uses every row. --telemetry-rotate-s S starts a new file\n"
+    "every S simulated seconds (telemetry-000.csv, ...): a 24 h run writes\n"
+    "3.5 GB of telemetry at 100 Hz.\n"
     "Exit status: 0 passed, 1 the run failed its checks, 2 bad usage or input.\n";
 
 bool parse_double(std::string_view s, double& out) {
@@ -73,6 +77,7 @@ struct SimOptions {
   bool plots = true, quiet = false, real_time = false, static_base = false, profile = false;
   bool control_drift = true;
   bool self_calibrate = false;
+  simtools::TelemetryFileOptions telemetry;
 };
 
 // Parses the command line into `o`. Returns -1 to go on, else the exit
@@ -114,6 +119,21 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
         return 2;
       }
       o.bias_angles = static_cast<int>(n);
+    } else if (a == "--telemetry-decimate" || a == "--telemetry-rotate-s") {
+      const char* v = value(args[i]);
+      double x = 0;
+      if (!v) return 2;
+      const bool decimate = a == "--telemetry-decimate";
+      if (!parse_double(v, x) || !(x > 0) || (decimate && (x != static_cast<int>(x) || x > 1e6))) {
+        std::fprintf(stderr, "hrg sim: %s '%s' must be a positive %s\n", args[i - 1], v,
+                     decimate ? "integer" : "number of seconds");
+        return 2;
+      }
+      if (decimate) {
+        o.telemetry.decimate = static_cast<std::size_t>(x);
+      } else {
+        o.telemetry.rotate_s = x;
+      }
     } else if (a == "--static-base") {
       o.static_base = true;
     } else if (a == "--real-time") {
@@ -149,9 +169,17 @@ simtools::JobConfig make_job(const SimOptions& o) {
 
 // report.json, telemetry.csv, bias.csv, allan.csv into `dir` (throws).
 void write_results(const std::filesystem::path& dir, const simtools::JobConfig& job,
-                   const simtools::JobResult& r) {
+                   const simtools::JobResult& r, const SimOptions& o) {
   std::ofstream(dir / "report.json") << simtools::report_json(job, r);
-  simtools::write_telemetry(dir / "telemetry.csv", job, r);
+  const auto files = simtools::write_telemetry(dir / "telemetry.csv", job, r, o.telemetry);
+  if (!o.quiet && (o.telemetry.decimate > 1 || o.telemetry.rotate_s > 0.0) && !files.empty()) {
+    const std::string rotation =
+        o.telemetry.rotate_s > 0.0 ? simtools::fmt(" of %.0f s each", o.telemetry.rotate_s) : "";
+    std::fprintf(stderr,
+                 "hrg sim: telemetry: every %zu-th row (%.1f Hz) in %zu file(s)%s from %s\n",
+                 o.telemetry.decimate, job.telemetry_hz / static_cast<double>(o.telemetry.decimate),
+                 files.size(), rotation.c_str(), files.front().filename().string().c_str());
+  }
   simtools::write_bias_csv(dir / "bias.csv", r);
   simtools::write_allan_csv(dir / "allan.csv", r);
 }
@@ -203,7 +231,7 @@ int sim_main(std::span<char* const> args) {
   }
   const bool passed = simtools::judge(job, r);
   try {
-    write_results(dir, job, r);
+    write_results(dir, job, r, o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: writing the results: %s\n", e.what());
     return 2;

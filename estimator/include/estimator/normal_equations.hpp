@@ -56,6 +56,8 @@ class NormalEquations {
 
   void add_window(const WindowContribution& w);
   void reset();
+  // New memory from the next window on (0: none); what is held is kept.
+  void set_forgetting_time_s(double tau_s) { config_.forgetting_time_s = tau_s; }
   Solution solve(Variant v) const;
 
   // Cramer-Rao bound on the five parameters for the windows taken, given the

@@ -25,6 +25,18 @@ struct WindowConfig {
   double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
   uint32_t check_period_frames = 0;    // after the campaign, a check window this often (0: none)
+  // Continued identification in operation: after the campaign, windows also
+  // open whenever one more keeps the run's excitation-off share at or below
+  // this (0: only the check windows above). The check windows count in it,
+  // and the gyro folds them into the identification (GyroConfig::
+  // continue_identification), so one window is both a check and new data.
+  double operation_duty = 0.0;
+  // Length of the windows after the campaign (0: length_frames). The decay
+  // information of a window grows as its length cubed, so at a given duty
+  // longer windows identify faster (a 10 s window: 8x a 5 s one's for 2x the
+  // time), as long as the amplitude lost in one stays within what the AGC
+  // recovers.
+  uint32_t operation_length_frames = 0;
 };
 
 struct WindowDecision {
@@ -70,7 +82,11 @@ class WindowScheduler {
 
  private:
   bool under_covered(uint32_t bin) const;
+  bool operation_window_due(bool is_static) const;
   void open(uint32_t bin, WindowDecision& d);
+  uint32_t operation_length() const {
+    return cfg_.operation_length_frames != 0 ? cfg_.operation_length_frames : cfg_.length_frames;
+  }
   uint32_t least_covered_bin() const;
 
   WindowConfig cfg_;
@@ -79,6 +95,7 @@ class WindowScheduler {
   uint64_t off_frames_ = 0;
   uint32_t since_start_ = 0;
   uint32_t in_window_frames_ = 0;
+  uint32_t window_length_ = 1;  // the running window's length (frames)
   uint32_t since_done_ = 0;
   uint32_t window_bin_ = 0;
   uint32_t windows_ = 0;

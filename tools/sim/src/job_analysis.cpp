@@ -57,13 +57,25 @@ void accumulate_errors(JobResult& r, const JobConfig& job) {
 
 // Parked bias: slope of the angle error over each park, in deg/h, and the
 // b + A sin 4theta + B cos 4theta fits.
+// The compensated fit is over the parks where the firmware stood behind its
+// model (compensation valid on every row): before that the output is the raw
+// angle plus an unproven model, and a slow-converging resonator would be
+// reported as not compensated at all.
 void parked_bias(JobResult& r, const JobConfig& job) {
-  std::vector<double> th, braw, bcomp, bmodel;
+  std::vector<double> th, braw, bcomp, bmodel, th_valid;
+  for (const TelemetryRow& row : r.rows) {
+    if (row.comp_valid) {
+      r.t_model_valid_s = row.t_s;
+      break;
+    }
+  }
   for (const ParkedInterval& p : job.parks) {
     std::vector<double> t, eraw, ecomp;
     double model = 0, theta_sum = 0;
+    bool valid = true;
     for (const TelemetryRow& row : r.rows) {
       if (row.t_s < p.t_begin_s || row.t_s > p.t_end_s || !row.out_valid) continue;
+      valid = valid && row.comp_valid;
       t.push_back(row.t_s);
       eraw.push_back(row.raw_angle_deg - row.true_angle_deg);
       ecomp.push_back(row.out_angle_deg - row.true_angle_deg);
@@ -77,15 +89,27 @@ void parked_bias(JobResult& r, const JobConfig& job) {
     pr.bias_comp_dph = slope(t, ecomp) * 3600.0;
     // The raw output error grows at -D/K (Omega K = -2 theta' + D).
     pr.bias_model_dph = -model / static_cast<double>(t.size());
+    pr.model_valid = valid;
     r.parks.push_back(pr);
     th.push_back(pr.theta_rad);
     braw.push_back(pr.bias_raw_dph);
-    bcomp.push_back(pr.bias_comp_dph);
     bmodel.push_back(pr.bias_model_dph);
+    if (valid) {
+      th_valid.push_back(pr.theta_rad);
+      bcomp.push_back(pr.bias_comp_dph);
+    }
   }
+  r.parks_model_valid = th_valid.size();
   r.fit_raw = fit_bias_4theta(th, braw);
-  r.fit_comp = fit_bias_4theta(th, bcomp);
+  r.fit_comp = fit_bias_4theta(th_valid, bcomp);
   r.fit_model = fit_bias_4theta(th, bmodel);
+  if (!job.parks.empty() && r.parks_model_valid < r.parks.size()) {
+    // The same bias test started once the model is valid: the run shifted by
+    // the wait (or, never valid here, at least twice as long).
+    const double wait_s =
+        r.t_model_valid_s >= 0.0 ? r.t_model_valid_s - job.parks.front().t_begin_s : job.duration_s;
+    if (wait_s > 0.0) r.bias_test_needs_s = std::ceil(job.duration_s + wait_s);
+  }
 }
 
 // Allan deviation of the compensated output rate (truth removed) over the

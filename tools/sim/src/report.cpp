@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "sim_tools/report.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <fstream>
+#include <memory>
+#include <numbers>
 #include <stdexcept>
 
 #include "recording/recording_writer.hpp"
@@ -36,6 +38,19 @@ void bias_json(JsonWriter& w, const char* key, const BiasFit& f) {
   w.end_object();
 }
 }  // namespace
+
+std::string bias_test_coverage(const JobResult& r) {
+  std::string s =
+      fmt("the compensated bias is measured on %zu of %zu parks (those with the model "
+          "valid throughout",
+          r.parks_model_valid, r.parks.size());
+  s += r.t_model_valid_s >= 0.0 ? fmt("; valid from %.1f s)", r.t_model_valid_s)
+                                : std::string("; the model was never valid)");
+  if (r.bias_test_needs_s > 0.0)
+    s += fmt("; this resonator needs a run of at least %.0f s (--duration %.0f)",
+             r.bias_test_needs_s, r.bias_test_needs_s);
+  return s;
+}
 
 bool judge(const JobConfig& job, JobResult& r) {
   r.failures.clear();
@@ -74,6 +89,11 @@ bool judge(const JobConfig& job, JobResult& r) {
             "misfit %.2f is above the noise (%.1f)%s; the pickoffs are read raw",
             fw::app::to_string(c.source), c.judged_s, c.misfit_after,
             job.firmware.gyro.max_window_misfit, before.c_str()));
+  }
+  if (!job.parks.empty() && !r.fit_comp.ok) {
+    // Too few parks with the model valid to fit: the compensation is not
+    // measured (not "no better than raw"), and the length it needs is said.
+    r.failures.push_back(bias_test_coverage(r));
   }
   if (!job.parks.empty() && r.fit_raw.ok && r.fit_comp.ok && r.identification.valid &&
       r.fit_comp.amplitude() > kAdbReduction * r.fit_raw.amplitude()) {
@@ -147,6 +167,9 @@ void drift_json(JsonWriter& w, const JobResult& r) {
   bias_json(w, "compensated", r.fit_comp);
   bias_json(w, "model", r.fit_model);
   w.integer("parked_angles", static_cast<long long>(r.parks.size()));
+  w.integer("parks_model_valid", static_cast<long long>(r.parks_model_valid));
+  w.number("t_model_valid_s", r.t_model_valid_s);
+  w.number("bias_test_needs_s", r.bias_test_needs_s);
   w.number("control_drift_mean_dph", r.control_drift_mean_dph);
   w.begin_array("parks");
   for (const auto& p : r.parks) {
@@ -155,6 +178,7 @@ void drift_json(JsonWriter& w, const JobResult& r) {
     w.number("raw_dph", p.bias_raw_dph);
     w.number("compensated_dph", p.bias_comp_dph);
     w.number("model_dph", p.bias_model_dph);
+    w.boolean("model_valid", p.model_valid);
     w.end_object();
   }
   w.end_array();
@@ -349,16 +373,41 @@ std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobCon
 
 }  // namespace
 
-void write_telemetry(const std::filesystem::path& path, const JobConfig& job, const JobResult& r) {
+std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& path,
+                                                   const JobConfig& job, const JobResult& r,
+                                                   const TelemetryFileOptions& o) {
   // Streamed row by row: an hour of telemetry is not held twice in memory.
-  recording::RecordingWriter wr(path, telemetry_columns(), job.firmware.chain.f_center_hz,
-                                job.firmware.gyro.angular_gain, telemetry_metadata(job));
+  std::vector<std::filesystem::path> files;
+  auto meta = telemetry_metadata(job);
+  const std::size_t every = o.decimate > 1 ? o.decimate : 1;
+  if (every > 1)
+    meta.emplace_back("decimation", fmt("every %zu-th row of %.0f Hz", every, job.telemetry_hz));
+  const auto file_for = [&](std::size_t part) {
+    if (!(o.rotate_s > 0.0)) return path;
+    std::filesystem::path p = path;
+    p.replace_filename(path.stem().string() + fmt("-%03zu", part) + path.extension().string());
+    return p;
+  };
+  std::unique_ptr<recording::RecordingWriter> wr;
+  std::size_t part = 0;
   std::vector<double> v;
-  for (const TelemetryRow& row : r.rows) {
+  for (std::size_t i = 0; i < r.rows.size(); i += every) {
+    const TelemetryRow& row = r.rows[i];
+    const std::size_t part_now =
+        o.rotate_s > 0.0 ? static_cast<std::size_t>(std::max(row.t_s, 0.0) / o.rotate_s) : 0;
+    if (!wr || part_now != part) {
+      if (wr) wr->close();
+      part = part_now;
+      files.push_back(file_for(part));
+      wr = std::make_unique<recording::RecordingWriter>(files.back(), telemetry_columns(),
+                                                        job.firmware.chain.f_center_hz,
+                                                        job.firmware.gyro.angular_gain, meta);
+    }
     telemetry_values(row, v);
-    wr.write_row(v);
+    wr->write_row(v);
   }
-  wr.close();
+  if (wr) wr->close();
+  return files;
 }
 
 recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r) {
@@ -443,9 +492,12 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   add("raw", r.fit_raw);
   add("compensated", r.fit_comp);
   add("drift model (truth)", r.fit_model);
-  bias.row({"parked angles", fmt("%zu", r.parks.size())});
+  bias.row({"parked angles", fmt("%zu (compensated fit over the %zu with the model valid)",
+                                 r.parks.size(), r.parks_model_valid)});
   bias.row({"control-loop drift", fmt("%+.3f", r.control_drift_mean_dph), "(mean D_Phi/K added)"});
   bias.print(out);
+  if (r.parks_model_valid < r.parks.size())
+    std::fprintf(out, "  bias test: %s\n", bias_test_coverage(r).c_str());
 
   TextTable ex(r.real_time ? "executive (real time: " + r.realtime_setup + ")"
                            : std::string("executive (lockstep; host time per task)"));

@@ -344,6 +344,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   lab.period_frames =
       fw::kBaseRateHz /
       fw::can::TelemetryConfig::defaults().rate_hz[static_cast<std::size_t>(fw::can::Tm::row)];
+  const auto observe_every =
+      static_cast<uint64_t>(std::max(1.0, std::round(opt.observe_every_s * fw::kBaseRateHz)));
   for (uint64_t k = 0; k < frames; ++k) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
@@ -356,6 +358,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
       log->write(fw::can::encode_lab_table(ts.rate_rad_s / kDeg, ts.temp_c, lab.seq++),
                  static_cast<uint64_t>(st.chain.t_s * 1e9));
     }
+    if (opt.observer && (k + 1) % observe_every == 0) opt.observer(*firmware, target);
     if (k % row_every != 0 || !stamp.history_full()) continue;
     if (!ref.set && st.out_valid) {
       ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,13 @@
 #include "sim_target/control.hpp"
 #include "sim_target/sim_config.hpp"
 #include "sim_tools/analysis.hpp"
+
+namespace hrg::fw::app {
+class Firmware;
+}
+namespace hrg::sim {
+class SimTarget;
+}
 
 namespace hrg::simtools {
 
@@ -95,6 +103,9 @@ struct ParkResult {
   double bias_raw_dph = 0.0;    // slope of (raw output - true angle), input-rate units
   double bias_comp_dph = 0.0;   // same with the drift compensation
   double bias_model_dph = 0.0;  // the true D/K at that angle (what the model predicts)
+  // The firmware reported its compensation valid over the whole park; the
+  // compensated fit takes only such parks.
+  bool model_valid = false;
 };
 
 struct TaskFigures {
@@ -152,6 +163,13 @@ struct JobResult {
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
+  // The bias test against the firmware's own word: parks with the model
+  // valid throughout (fit_comp is over these only), when it first became
+  // valid, and the run length the resonator needs for every park to be
+  // measured with it (0 when this run was long enough).
+  std::size_t parks_model_valid = 0;
+  double t_model_valid_s = -1.0;
+  double bias_test_needs_s = 0.0;
   std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
   double allan_span_s = 0.0;      // length of the still stretch it was computed on
   double tracking_rms_deg = 0.0;  // compensated output - true, after operate
@@ -180,6 +198,10 @@ struct RunOptions {
   bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
   int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
   bool profile = false;    // time the simulated target's stages (JobResult::sim_stages)
+  // Called every observe_every_s of simulated time with the firmware and the
+  // simulated target (benches and studies that follow the identification).
+  std::function<void(const fw::app::Firmware&, const sim::SimTarget&)> observer;
+  double observe_every_s = 60.0;
 };
 
 // Runs firmware + simulated target: in lockstep (as fast as the host allows,
