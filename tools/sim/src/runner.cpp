@@ -331,6 +331,8 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   fw::Mode last_mode = fw::Mode::power_up;
   RowStamper stamp(job);
   AngleReference ref;
+  const auto observe_every =
+      static_cast<uint64_t>(std::max(1.0, std::round(opt.observe_every_s * fw::kBaseRateHz)));
   for (uint64_t k = 0; k < frames; ++k) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
@@ -338,6 +340,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     stamp.after_block(*firmware, target);
     track_events(gyro, target, last_mode, r);
     drain_can(target, log.get(), st.chain.t_s, r);
+    if (opt.observe && (k + 1) % observe_every == 0) opt.observe(*firmware);
     if (k % row_every != 0 || !stamp.history_full()) continue;
     if (!ref.set && st.out_valid) {
       ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,10 @@
 #include "sim_target/control.hpp"
 #include "sim_target/sim_config.hpp"
 #include "sim_tools/analysis.hpp"
+
+namespace hrg::fw::app {
+class Firmware;
+}  // namespace hrg::fw::app
 
 namespace hrg::simtools {
 
@@ -171,6 +176,10 @@ struct RunOptions {
   bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
   int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
   bool profile = false;    // time the simulated target's stages (JobResult::sim_stages)
+  // Called after every observe_every_s of simulated time with the firmware
+  // (a study samples the model in force as it converges); empty: never.
+  std::function<void(const fw::app::Firmware&)> observe;
+  double observe_every_s = 1.0;
 };
 
 // Runs firmware + simulated target: in lockstep (as fast as the host allows,
