@@ -29,8 +29,9 @@ def fmt(v):
 
 def write_csv(study, path):
     cols = ["point", "split_hz", "dq_over_q", "gap", "q", "raw_adb_dph", "comp_adb_dph",
-            "raw_bias_dph", "comp_bias_dph", "crb_adb_end_dph", "meas_sigma_dph",
-            "predicted_adb_dph", "ratio", "meets_bound"]
+            "raw_bias_dph", "comp_bias_dph", "model_adb_end_dph", "crb_adb_end_dph",
+            "meas_sigma_dph", "control_drift_mean_dph", "predicted_adb_dph", "ratio",
+            "meets_bound"]
     with open(path, "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols + ["t_reach_%s_dph_s" % t for t in THRESHOLDS]

@@ -46,6 +46,7 @@ void seed_json(simtools::JsonWriter& w, const SeedResult& s) {
   w.boolean("compensation_applied", s.comp_applied);
   w.integer("model_checks_failed", s.model_checks_failed);
   w.number("excitation_off", s.excitation_off);
+  w.number("control_drift_mean_dph", s.control_drift_mean_dph);
   w.number("raw_adb_dph", s.raw_adb_dph);
   w.number("comp_adb_dph", s.comp_adb_dph);
   w.number("raw_bias_dph", s.raw_bias_dph);
@@ -80,7 +81,9 @@ std::string point_json_line(const PointResult& p) {
   w.number("raw_bias_dph", p.raw_bias_dph);
   w.number("comp_bias_dph", p.comp_bias_dph);
   w.number("crb_adb_end_dph", or_none(p.crb_adb_end_dph));
+  w.number("model_adb_end_dph", or_none(p.model_adb_end_dph));
   w.number("meas_sigma_dph", p.meas_sigma_dph);
+  w.number("control_drift_mean_dph", p.control_drift_mean_dph);
   w.number("predicted_adb_dph", p.predicted_adb_dph);
   w.number("ratio", or_none(p.ratio));
   w.boolean("meets_bound", p.meets_bound);

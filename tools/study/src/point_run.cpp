@@ -97,6 +97,7 @@ SeedResult run_seed(const Grid& grid, const PointSpec& spec, int seed_index) {
   s.comp_applied = r.compensation_applied;
   s.model_checks_failed = r.model_checks_failed;
   s.excitation_off = r.excitation_off_fraction;
+  s.control_drift_mean_dph = r.control_drift_mean_dph;
   copy_bias_test(r, job, s);
   return s;
 }

@@ -62,6 +62,23 @@ void reach_times(PointResult& p) {
   }
 }
 
+// Every seed identified its resonator in time and the model in force leaves
+// no more than twice its bound: the rest of the compensated ADB is drift the
+// resonator model does not hold, the control loops' D_Phi (the pump through
+// the ring electrode's gap harmonic, the forcers).
+void explain_outside_model(PointResult& p) {
+  if (p.model_adb_end_dph < 0.0 || p.crb_adb_end_dph <= 0.0 ||
+      p.model_adb_end_dph > kBoundFactor * p.crb_adb_end_dph)
+    return;
+  std::string what =
+      fmt("drift outside the resonator model: the model leaves %.3g deg/h (bound %.3g deg/h)",
+          p.model_adb_end_dph, p.crb_adb_end_dph);
+  what += fmt(", the bias test shows %.3g deg/h: control-loop drift D_Phi", p.comp_adb_dph);
+  if (p.spec.gap > 0.0) what += fmt(" (ring-electrode gap harmonic %.3g)", p.spec.gap);
+  what += fmt(", mean D_Phi/K added %.3g deg/h", p.control_drift_mean_dph);
+  p.reasons.push_back(what);
+}
+
 // The recognised causes of a miss, from what the runs saw.
 void explain_miss(const Grid& grid, PointResult& p) {
   if (!p.setup_error.empty()) {
@@ -91,6 +108,7 @@ void explain_miss(const Grid& grid, PointResult& p) {
                           " model checks failed" + seed);
     }
   }
+  if (p.reasons.empty()) explain_outside_model(p);
 }
 
 }  // namespace
@@ -109,6 +127,9 @@ void summarise_point(const Grid& grid, PointResult& p) {
     p.t_s.push_back(static_cast<double>(i + 1) * grid.sample_every_s);
   reach_times(p);
   p.crb_adb_end_dph = p.crb_adb_dph.empty() ? -1.0 : p.crb_adb_dph.back();
+  p.model_adb_end_dph = p.model_adb_dph.empty() ? -1.0 : p.model_adb_dph.back();
+  p.control_drift_mean_dph =
+      mean_of(s, [](const SeedResult& r) { return r.control_drift_mean_dph; });
   const double crb = p.crb_adb_end_dph > 0.0 ? p.crb_adb_end_dph : 0.0;
   p.predicted_adb_dph = std::hypot(crb, p.meas_sigma_dph);
   p.ratio = p.predicted_adb_dph > 0.0 ? p.comp_adb_dph / p.predicted_adb_dph : -1.0;

@@ -27,7 +27,8 @@ struct SeedResult {
   bool bias_fit = false;       // the parked-angle fit had enough angles
   bool comp_applied = false;   // the compensation in force at the end
   uint32_t model_checks_failed = 0;
-  double excitation_off = 0;  // fraction of the run
+  double excitation_off = 0;          // fraction of the run
+  double control_drift_mean_dph = 0;  // mean D_Phi/K the firmware added over the valid output
   // The parked-angle bias test (IEEE 1431 style), raw and compensated.
   double raw_adb_dph = 0, comp_adb_dph = 0, raw_bias_dph = 0, comp_bias_dph = 0;
   double meas_sigma_dph = 0;  // the compensated fit's own 1-sigma on the ADB (bias test noise)
@@ -45,8 +46,10 @@ struct PointResult {
   std::vector<SeedResult> seeds;
   // Means over seeds.
   double raw_adb_dph = 0, comp_adb_dph = 0, raw_bias_dph = 0, comp_bias_dph = 0;
-  double crb_adb_end_dph = 0;  // Cramer-Rao bound of the model's ADB at the run's end
-  double meas_sigma_dph = 0;   // bias test noise on the ADB
+  double crb_adb_end_dph = 0;    // Cramer-Rao bound of the model's ADB at the run's end
+  double model_adb_end_dph = 0;  // the ADB the model in force leaves at the end (truth)
+  double control_drift_mean_dph = 0;
+  double meas_sigma_dph = 0;  // bias test noise on the ADB
   // The bound the compensated ADB is held to: the model's CRB and the bias
   // test's own noise in quadrature.
   double predicted_adb_dph = 0;
