@@ -73,8 +73,12 @@ int parse(std::span<char* const> args, Args& a) {
       std::fputs(kUsage, stdout);
       return 1;
     }
-    if (arg == "--count" || arg == "--no-plots") {
-      (arg == "--count" ? a.count : a.plots) = arg == "--count";
+    if (arg == "--count") {
+      a.count = true;
+      continue;
+    }
+    if (arg == "--no-plots") {
+      a.plots = false;
       continue;
     }
     const bool takes = arg == "--grid" || arg == "--out" || arg == "--jobs" || arg == "--point" ||
