@@ -133,8 +133,13 @@ void summarise_point(const Grid& grid, PointResult& p) {
   const double crb = p.crb_adb_end_dph > 0.0 ? p.crb_adb_end_dph : 0.0;
   p.predicted_adb_dph = std::hypot(crb, p.meas_sigma_dph);
   p.ratio = p.predicted_adb_dph > 0.0 ? p.comp_adb_dph / p.predicted_adb_dph : -1.0;
-  p.meets_bound =
-      p.setup_error.empty() && !s.empty() && p.predicted_adb_dph > 0.0 && p.ratio <= kBoundFactor;
+  // A bias test counts only where every seed measured it with its model
+  // converged and in force.
+  bool measured = p.setup_error.empty() && !s.empty();
+  for (const SeedResult& r : s)
+    measured = measured && r.locked && r.bias_fit && r.comp_applied && r.t_converged_s >= 0.0 &&
+               r.t_converged_s <= r.t_bias_start_s;
+  p.meets_bound = measured && p.predicted_adb_dph > 0.0 && p.ratio <= kBoundFactor;
   p.reasons.clear();
   if (!p.meets_bound) explain_miss(grid, p);
 }

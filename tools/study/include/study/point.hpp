@@ -54,7 +54,7 @@ struct PointResult {
   // test's own noise in quadrature.
   double predicted_adb_dph = 0;
   double ratio = 0;                  // comp_adb_dph / predicted_adb_dph
-  bool meets_bound = false;          // ratio <= 2
+  bool meets_bound = false;          // ratio <= 2, on bias tests with the converged model in force
   std::vector<std::string> reasons;  // why it does not (empty when it does)
   // Series (mean over seeds) and the time each threshold is reached for good
   // (-1: not within the run), with the CRB at that time.
