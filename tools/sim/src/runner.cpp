@@ -340,7 +340,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     stamp.after_block(*firmware, target);
     track_events(gyro, target, last_mode, r);
     drain_can(target, log.get(), st.chain.t_s, r);
-    if (opt.observe && (k + 1) % observe_every == 0) opt.observe(*firmware);
+    if (opt.observer && (k + 1) % observe_every == 0) opt.observer(*firmware, target);
     if (k % row_every != 0 || !stamp.history_full()) continue;
     if (!ref.set && st.out_valid) {
       ref = {true, stamp.truth().input_angle_rad, st.out_angle_rad, st.out_raw_angle_rad};

@@ -50,7 +50,7 @@ class ConvergenceProbe {
         k_(job.firmware.gyro.angular_gain),
         out_(out) {}
 
-  void operator()(const fw::app::Firmware& firmware) const {
+  void operator()(const fw::app::Firmware& firmware, const sim::SimTarget& /*target*/) const {
     const fw::EstimatorPort& est = firmware.estimator();
     double e_c = truth_[1], e_s = truth_[2];
     if (firmware.gyro().status().compensation_applied) {
@@ -86,7 +86,7 @@ SeedResult run_seed(const Grid& grid, const PointSpec& spec, int seed_index) {
   SeedResult s;
   s.seed = job.sim.seed;
   simtools::RunOptions opt;
-  opt.observe = ConvergenceProbe(job, s);
+  opt.observer = ConvergenceProbe(job, s);
   opt.observe_every_s = grid.sample_every_s;
   const simtools::JobResult r = simtools::run_job(job, opt);
   // The bound was taken at unit noise: scale by the run's per-sample noise.

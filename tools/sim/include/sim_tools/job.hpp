@@ -14,7 +14,10 @@
 
 namespace hrg::fw::app {
 class Firmware;
-}  // namespace hrg::fw::app
+}
+namespace hrg::sim {
+class SimTarget;
+}
 
 namespace hrg::simtools {
 
@@ -176,10 +179,10 @@ struct RunOptions {
   bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
   int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
   bool profile = false;    // time the simulated target's stages (JobResult::sim_stages)
-  // Called after every observe_every_s of simulated time with the firmware
-  // (a study samples the model in force as it converges); empty: never.
-  std::function<void(const fw::app::Firmware&)> observe;
-  double observe_every_s = 1.0;
+  // Called every observe_every_s of simulated time with the firmware and the
+  // simulated target (benches and studies that follow the identification).
+  std::function<void(const fw::app::Firmware&, const sim::SimTarget&)> observer;
+  double observe_every_s = 60.0;
 };
 
 // Runs firmware + simulated target: in lockstep (as fast as the host allows,
