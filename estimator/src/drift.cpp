@@ -2,7 +2,9 @@
 #include <estimator/drift.hpp>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <estimator/conditioning.hpp>
 
@@ -93,15 +95,32 @@ bool ControlDriftEstimator::add_sample(const Sample& s) {
     const double d = -fB_cos / aA + (aB / aA) * fA_cos / aA;
     if (!have_estimate_) {
       d_phi_rad_s_ = d;
+      d_var_ = 0.0;
+      alpha_ = 1.0;
       have_estimate_ = true;
     } else {
-      const double alpha = 1.0 - std::exp(-dt / config_.smoothing_s);
-      d_phi_rad_s_ += alpha * (d - d_phi_rad_s_);
+      alpha_ = 1.0 - std::exp(-dt / config_.smoothing_s);
+      const double innovation = d - d_phi_rad_s_;
+      d_phi_rad_s_ += alpha_ * innovation;
+      d_var_ += alpha_ * (innovation * innovation * (1.0 - alpha_) - d_var_);
     }
   }
   prev_ = b;
   have_prev_ = true;
   return true;
+}
+
+double ControlDriftEstimator::d_phi_sigma_rad_s() const {
+  // Variance of a first-order low-pass of independent samples: var a/(2-a).
+  // The first blocks (alpha 1) have no spread yet: infinite until then.
+  if (!have_estimate_ || !(alpha_ < 1.0)) return std::numeric_limits<double>::infinity();
+  return std::sqrt(std::max(d_var_, 0.0) * alpha_ / (2.0 - alpha_));
+}
+
+double ControlDriftEstimator::used_d_phi_rad_s() const {
+  if (!have_estimate_) return 0.0;
+  if (config_.min_sigmas <= 0.0) return d_phi_rad_s_;
+  return std::fabs(d_phi_rad_s_) >= config_.min_sigmas * d_phi_sigma_rad_s() ? d_phi_rad_s_ : 0.0;
 }
 
 void PumpDriftEstimator::fold_segment() {
@@ -111,6 +130,10 @@ void PumpDriftEstimator::fold_segment() {
     if (config_.forgetting_time_s > 0 && have_fold_)
       decay = std::exp(-(t_last_s_ - t_last_fold_s_) / config_.forgetting_time_s);
     m_ = decay * m_ + c * static_cast<double>(config_.block_samples);
+    for (Mat4& b : batch_)
+      b *= decay;
+    batch_[segments_ % kBatches] += c * static_cast<double>(config_.block_samples);
+    ++segments_;
     fit_s_ = decay * fit_s_ + (t_last_s_ - t0_s_);
     t_last_fold_s_ = t_last_s_;
     have_fold_ = true;
@@ -198,6 +221,40 @@ double PumpDriftEstimator::gap() const {
   if (!valid()) return 0.0;
   const Eigen::Vector3d c = coefficients();
   return c(0) > 0.0 ? 2.0 * std::hypot(c(1), c(2)) / c(0) : 0.0;
+}
+
+namespace {
+// (b1, b2) of a 3x3 fit [N b; b' y'y]; false when N is singular.
+bool gap_harmonic(const Eigen::Matrix4d& m, Eigen::Vector2d& g) {
+  const Eigen::Matrix3d n = m.topLeftCorner<3, 3>();
+  if (!(conditioning_of<3>(n).kappa_2 < 1e8)) return false;
+  const Eigen::Vector3d s = n.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::Matrix3d a = s.asDiagonal() * n * s.asDiagonal();
+  const Eigen::Vector3d x =
+      s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * m.topRightCorner<3, 1>());
+  g = x.tail<2>();
+  return g.allFinite();
+}
+}  // namespace
+
+double PumpDriftEstimator::gap_sigmas() const {
+  if (!valid() || segments_ < 2 * kBatches) return 0.0;
+  Eigen::Vector2d g;
+  if (!gap_harmonic(m_, g)) return 0.0;
+  std::array<Eigen::Vector2d, kBatches> gb;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (int j = 0; j < kBatches; ++j) {
+    if (!gap_harmonic(batch_[static_cast<std::size_t>(j)], gb[static_cast<std::size_t>(j)]))
+      return 0.0;
+    mean += gb[static_cast<std::size_t>(j)] / kBatches;
+  }
+  // Covariance of the full fit ~ that of the mean of the batch fits.
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& x : gb)
+    cov += (x - mean) * (x - mean).transpose();
+  cov /= static_cast<double>(kBatches) * (kBatches - 1);
+  const double m2 = g.dot(cov.ldlt().solve(g));
+  return m2 > 0.0 && std::isfinite(m2) ? std::sqrt(m2) : 0.0;
 }
 
 }  // namespace hrg::est

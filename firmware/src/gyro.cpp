@@ -186,7 +186,7 @@ void Gyro::on_mode_change(Mode from, Mode to) {
   if (to == Mode::free_decay) identifier_.begin_window(status_.chain.t_s);
   if (from == Mode::free_decay) {
     if (to == Mode::recover) {
-      if (compensation_ready_) {
+      if (compensation_ready_ && !cfg_.continue_identification) {
         identifier_.end_check_window();
       } else {
         identifier_.end_window();

@@ -59,6 +59,26 @@ void WindowScheduler::open(uint32_t bin, WindowDecision& d) {
   moving_ = false;
 }
 
+bool WindowScheduler::operation_window_due(bool is_static) const {
+  // Check windows: the model in force is tested against new free decays
+  // (at whatever turn rate and temperature the gyro now sees) at least every
+  // check period, and the first time the base has been still for a window
+  // period, at once (what a fit on a turning base absorbs shows on a still
+  // one).
+  if (cfg_.check_period_frames != 0) {
+    if (since_start_ >= cfg_.check_period_frames) return true;
+    if (!static_checked_ && is_static && static_frames_ >= cfg_.period_frames &&
+        since_start_ >= cfg_.period_frames) {
+      return true;
+    }
+  }
+  // Continued identification: as many windows as the duty allows, never
+  // closer than the window period.
+  if (cfg_.operation_duty <= 0.0 || since_start_ < cfg_.period_frames) return false;
+  const double off_after = static_cast<double>(off_frames_ + cfg_.length_frames);
+  return off_after <= cfg_.operation_duty * static_cast<double>(frames_ + cfg_.length_frames);
+}
+
 WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
                                      const EstimatorHealth& health) {
   WindowDecision d;
@@ -94,16 +114,10 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
     const bool refresh =
         cfg_.refresh_period_frames != 0 && ++since_done_ >= cfg_.refresh_period_frames;
     if (!refresh) {
-      // Check windows: the model in force is tested against new free decays
-      // (at whatever turn rate and temperature the gyro now sees), and the
-      // first time the base has been still for a window period, at once
-      // (what a fit on a turning base absorbs shows on a still one).
+      // In operation: check and continued-identification windows.
       const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
       static_frames_ = is_static ? static_frames_ + 1 : 0;
-      const bool due = since_start_ >= cfg_.check_period_frames ||
-                       (!static_checked_ && static_frames_ >= cfg_.period_frames &&
-                        since_start_ >= cfg_.period_frames);
-      if (cfg_.check_period_frames != 0 && mode == Mode::operate && due) {
+      if (mode == Mode::operate && operation_window_due(is_static)) {
         open(bin_of(theta_rad), d);
         static_checked_ = static_checked_ || is_static;
       }

@@ -22,6 +22,9 @@
 // compensator integrates the modelled D/K, so a new estimate changes only the
 // rate from then on and the output never jumps.
 
+#include <array>
+#include <cstdint>
+
 #include <estimator/types.hpp>
 
 namespace hrg::est {
@@ -88,6 +91,11 @@ class ControlDriftEstimator {
   struct Config {
     double block_s = 0.1;      // block length for the derivative estimate
     double smoothing_s = 5.0;  // first-order low-pass of D_Phi
+    // The estimate is used (used_d_phi_rad_s) only when it stands this many
+    // of its own standard errors away from zero: with nothing to find, the
+    // noise of the block derivatives would otherwise be added as drift.
+    // 0: always used.
+    double min_sigmas = 3.0;
   };
   struct Sample {
     double t_s{0};
@@ -110,6 +118,12 @@ class ControlDriftEstimator {
   // Restart after a free-decay window (the loops re-acquire).
   void restart();
   double d_phi_rad_s() const { return d_phi_rad_s_; }
+  // Standard error of d_phi_rad_s(): the spread of the block estimates
+  // about it through the low-pass (independent blocks; successive block
+  // derivatives are anti-correlated, so this is on the safe side).
+  double d_phi_sigma_rad_s() const;
+  // d_phi_rad_s() when it clears Config::min_sigmas, else 0.
+  double used_d_phi_rad_s() const;
   bool valid() const { return have_estimate_; }
 
  private:
@@ -127,6 +141,8 @@ class ControlDriftEstimator {
   double t_last_s_{0};
   bool started_{false};
   double d_phi_rad_s_{0};
+  double d_var_{0};    // low-passed variance of the block estimates about d_phi_rad_s_
+  double alpha_{1.0};  // the low-pass's last weight
 };
 
 // Drift of the ring-electrode parametric pump through the gap non-uniformity
@@ -162,6 +178,14 @@ class PumpDriftEstimator {
     // (nu |eps| / 2, 0.1-0.3 deg/h) is noise, not drift; a machined gap
     // harmonic of 1e-2 drifts by ~10 deg/h. 0: always used.
     double min_gap = 0.0;
+    // ... and only when the gap harmonic (b1, b2) stands this many of its own
+    // standard errors from zero (gap_sigmas()): a resonator whose pump
+    // effort is small (high Q) leaves a fitted gap of 1e-2 from noise and
+    // from the resonator model's early errors, which the fit takes for a gap
+    // until the model has converged. Measured with an ideal electrode: up
+    // to 5.9 (Q 2e7, at 160 s of the default run); with eps_p 0.02, eps_q
+    // 0.01 above 6.5 from 230 s on. 0: not checked.
+    double min_gap_sigmas = 6.5;
   };
   using Sample = ControlDriftEstimator::Sample;
 
@@ -185,8 +209,19 @@ class PumpDriftEstimator {
   Eigen::Vector3d coefficients() const;
   // The fitted gap harmonic |eps| = 2 |(b1, b2)| / b0; 0 before valid().
   double gap() const;
-  // valid() and gap() >= Config::min_gap: the pump's D_Phi is worth adding.
-  bool usable() const { return valid() && gap() >= config_.min_gap; }
+  // Significance of the gap harmonic: sqrt(b' C^-1 b) for b = (b1, b2) and
+  // C their covariance, from the scatter of kBatches fits over interleaved
+  // segments (batch means: the rows of a segment are running integrals, so
+  // their residuals are correlated and the fit's own residual would
+  // understate it by ~10x). 0 before valid() or while a batch fit is
+  // singular.
+  double gap_sigmas() const;
+  static constexpr int kBatches = 8;
+  // valid(), gap() >= Config::min_gap and gap_sigmas() >= Config::
+  // min_gap_sigmas: the pump's D_Phi is worth adding.
+  bool usable() const {
+    return valid() && gap() >= config_.min_gap && gap_sigmas() >= config_.min_gap_sigmas;
+  }
 
  private:
   using Vec4 = Eigen::Matrix<double, 4, 1>;
@@ -195,7 +230,9 @@ class PumpDriftEstimator {
 
   Config config_{};
   ParamVector p_ = ParamVector::Zero();
-  Mat4 m_ = Mat4::Zero();  // [N b; b' yy] over folded segments
+  Mat4 m_ = Mat4::Zero();               // [N b; b' yy] over folded segments
+  std::array<Mat4, kBatches> batch_{};  // the same sums over segments n, n + kBatches, ...
+  uint32_t segments_{0};                // segments folded
   double fit_s_{0};
   double t_last_fold_s_{0};
   bool have_fold_{false};

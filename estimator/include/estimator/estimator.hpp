@@ -97,12 +97,14 @@ class Estimator {
   const ParamVector& model() const { return comp_.model(); }
   const Solution& last_solution() const { return last_; }
   double correction_rad() const { return comp_.correction_rad(); }
-  // D_Phi at pattern angle theta (eq. 23 part + ring-pump gap part), rad/s.
+  // D_Phi at pattern angle theta (eq. 23 part + ring-pump gap part), rad/s;
+  // each part only when it clears its own uncertainty (nothing is added
+  // when there is nothing to find).
   double d_phi_rad_s(double theta_A_rad) const {
-    return (control_.valid() ? control_.d_phi_rad_s() : 0.0) +
-           (pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
+    return control_.used_d_phi_rad_s() + (pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
   }
   const PumpDriftEstimator& pump_drift() const { return pump_; }
+  const ControlDriftEstimator& control_drift() const { return control_; }
   Conditioning conditioning() const { return ls_.conditioning(); }
   const CoverageHistogram& coverage_s() const { return ls_.coverage_s(); }
   // Pattern angle (centre of the least covered 4theta bin, in [0, pi/2)).

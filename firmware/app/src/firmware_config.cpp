@@ -14,6 +14,10 @@ void apply_window_plan(WindowConfig& w, WindowPlan plan) {
     w.max_wait_frames = 20000;
     w.windows_per_bin = 4;
     w.min_windows_per_bin = 4;
+    // In operation a check window at least every 10 min (0.8 %), and
+    // continued identification up to 2 % excitation off over the run.
+    w.check_period_frames = 600000;
+    w.operation_duty = kDefaultOperationDuty;
     return;
   }
   // Long windows: the decay-rate information of one window grows as T^3
@@ -24,6 +28,10 @@ void apply_window_plan(WindowConfig& w, WindowPlan plan) {
   w.max_wait_frames = 10000;
   w.windows_per_bin = 4;
   w.min_windows_per_bin = 2;
+  // A few-minute run: a check window every 20 s after the campaign (they
+  // also feed the identification); the duty rule never opens more.
+  w.check_period_frames = 20000;
+  w.operation_duty = kDefaultOperationDuty;
 }
 
 FirmwareConfig default_firmware_config(const ConverterLayout& conv, WindowPlan plan) {
@@ -35,9 +43,6 @@ FirmwareConfig default_firmware_config(const ConverterLayout& conv, WindowPlan p
   w.condition_good = 50.0;
   w.coverage_good = 1.0;
   apply_window_plan(w, plan);
-  // After the campaign, a check window every 20 s tests the model in force
-  // (the compensation is applied only while they agree with it).
-  w.check_period_frames = 20000;
   // The pump's gap part of D_Phi is used only once the pattern angles seen
   // with the excitation on make its 3x3 fit well conditioned: an early fit
   // from a few nearby angles adds more than it removes (default run: ADB

@@ -30,6 +30,10 @@ struct GyroConfig {
   bool compensate_drift = true;          // add the drift model (after the window campaign)
   bool compensate_control_drift = true;  // and D_Phi with the excitation on (needs the model)
   bool identify = true;                  // run the windows (off: use the model it has)
+  // Windows after the campaign (checks, WindowConfig::operation_duty) are
+  // folded into the identification after their check, so the model keeps
+  // converging and follows slow changes (off: they only check it).
+  bool continue_identification = true;
   // Do no harm: the model applied at the end of the campaign is withdrawn
   // for good as soon as a check window disagrees with it (misfit,
   // EstimatorHealth::window_misfit, above this): the output is then the raw

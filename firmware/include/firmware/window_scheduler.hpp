@@ -25,6 +25,12 @@ struct WindowConfig {
   double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
   uint32_t check_period_frames = 0;    // after the campaign, a check window this often (0: none)
+  // Continued identification in operation: after the campaign, windows also
+  // open whenever one more keeps the run's excitation-off share at or below
+  // this (0: only the check windows above). The check windows count in it,
+  // and the gyro folds them into the identification (GyroConfig::
+  // continue_identification), so one window is both a check and new data.
+  double operation_duty = 0.0;
 };
 
 struct WindowDecision {
@@ -70,6 +76,7 @@ class WindowScheduler {
 
  private:
   bool under_covered(uint32_t bin) const;
+  bool operation_window_due(bool is_static) const;
   void open(uint32_t bin, WindowDecision& d);
   uint32_t least_covered_bin() const;
 

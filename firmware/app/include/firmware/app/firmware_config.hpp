@@ -29,9 +29,14 @@ enum class WindowPlan : uint8_t {
   // few-minute runs.
   standard,
   // 5 s windows every 10 s, 4 per bin, all required: runs of an hour or more
-  // with an identification phase of their own.
+  // with an identification phase of their own; then a check window at least
+  // every 10 min and continued identification at 2 % excitation off.
   long_run,
 };
+
+// Excitation-off share that continued identification keeps to in operation
+// (WindowConfig::operation_duty).
+inline constexpr double kDefaultOperationDuty = 0.02;
 
 // The firmware's defaults for a board with this converter layout, derived.
 FirmwareConfig default_firmware_config(const ConverterLayout& conv,
