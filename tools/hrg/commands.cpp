@@ -13,14 +13,17 @@ namespace hrg::cli {
 int scenario_check_main(std::span<char* const> args);     // scenario_check_command.cpp
 int characterize_main(std::span<char* const> args);       // characterize_command.cpp
 int calibration_check_main(std::span<char* const> args);  // calibration_check_command.cpp
+int study_main(std::span<char* const> args);              // study_command.cpp
 
 namespace {
-constexpr std::array<Command, 8> kCommands{{
+constexpr std::array<Command, 9> kCommands{{
     {"sim", "run the firmware against the simulated gyro (the main job)", &sim_main},
     {"audit", "locate sim/recording mismatches and name the left-out physics",
      &hrg::audit::audit_main},
     {"characterize", "IEEE 1431 / 952 test procedures on the simulated gyro: the data sheet",
      &characterize_main},
+    {"study", "tolerance: the firmware over a grid of resonators against the Cramer-Rao bound",
+     &study_main},
     {"audit-bench", "confusion matrix of hrg audit on recordings with concealed effects",
      &hrg::audit::audit_bench_main},
     {"can-decode", "turn a candump log of the CAN telemetry into an hrg-recording v1",

@@ -13,7 +13,8 @@ test_pkgs=(clang clang-format libclang-rt-14-dev valgrind can-utils gpiod libgpi
   python3-can g++-aarch64-linux-gnu g++-arm-linux-gnueabihf libc6-dev-arm64-cross
   libc6-dev-armhf-cross qemu-user qemu-system-arm qemu-system-x86 gcc-arm-none-eabi
   libstdc++-arm-none-eabi-newlib linux-image-amd64 linux-headers-amd64 linux-source-6.1
-  busybox-static cpio kmod xz-utils make iproute2 debootstrap chromium)
+  busybox-static cpio kmod xz-utils make iproute2 debootstrap chromium
+  python3-distributed python3-dask)
 # Target libraries for the Linux board tests (Debian multiarch).
 cross_pkgs=(libcpputest-dev:arm64 libcpputest-dev:armhf libgpiod-dev:arm64 libgpiod-dev:armhf)
 

@@ -30,8 +30,10 @@ void refuse_conflicts(const std::string& path, bool own_profile, const ScheduleO
                                 "test for --bias-angles (use a constant [rate] to get one)");
 }
 
-// The scenario's resonator and converters in the firmware's configuration.
-void adopt_resonator(JobConfig& job, const sim::SimConfig& sc, const std::string& path) {
+}  // namespace
+
+void adopt_resonator(JobConfig& job, const std::string& what) {
+  const sim::SimConfig& sc = job.sim;
   job.firmware.gyro.angular_gain = sc.resonator.angular_gain;
   derive_firmware_config(job);
   job.firmware.chain.f_center_hz = sc.resonator.f_hz;
@@ -43,10 +45,8 @@ void adopt_resonator(JobConfig& job, const sim::SimConfig& sc, const std::string
   // The PLL range above (+-10 Hz about the resonance) and the converters
   // must still make a usable chain (e.g. the NCO's periodicity rule).
   if (const char* err = dsp::check_chain_config(job.firmware.chain))
-    throw std::invalid_argument("scenario " + path + ": signal chain configuration: " + err);
+    throw std::invalid_argument(what + ": signal chain configuration: " + err);
 }
-
-}  // namespace
 
 JobConfig make_job(const std::string& scenario_path, const ScheduleOptions& o) {
   if (!scenario_path.empty()) return job_from_scenario(scenario_path, o);
@@ -83,7 +83,7 @@ JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o) {
     job.earth_rate_rad_s = sc.rate_rad_s.value(0.0);
     job.description += " with the default rate-table schedule";
   }
-  adopt_resonator(job, sc, path);
+  adopt_resonator(job, "scenario " + path);
   return job;
 }
 

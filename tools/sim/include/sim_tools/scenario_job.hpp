@@ -27,6 +27,11 @@ struct ScheduleOptions {
 // the key, or std::runtime_error.
 JobConfig make_job(const std::string& scenario_path, const ScheduleOptions& o);
 
+// Copies job.sim's resonator and electrodes into the firmware's configuration
+// (K, chain centre and PLL range, Q, pump and forcer gains) and checks that
+// the chain can serve it. Throws std::invalid_argument naming `what`.
+void adopt_resonator(JobConfig& job, const std::string& what);
+
 // A job from a TOML scenario (sim_target/scenarios/*.toml), as make_job.
 JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o);
 
