@@ -174,6 +174,7 @@ class SimTarget {
   bool profiling_ = false;
   SimStageTimes stage_times_;
   std::array<Drive, kChunk> drives_{};
+  std::array<PickoffOutput, kChunk> pickoffs_{};
   std::array<double, 2 * kChunk> volts_{};
   std::array<double, 2 * kChunk> noise_buf_{};
 };

@@ -86,6 +86,12 @@ class Resonator {
 
   // Advances by dt_s (normally 1/fs) with the drive held. Pure physics.
   void step(const Drive& u, double dt_s);
+  // n steps under drives[0..n): pickoffs[k] = measured() before step k.
+  // The same numbers as n calls of measured() and step(); when the rate and
+  // the temperature hold one value over the n steps and no amplitude-
+  // dependent effect is on, the per-step profile reads, re-expansion checks
+  // and coefficient updates are done once for the n steps.
+  void step_block(const Drive* drives, std::size_t n, double dt_s, PickoffOutput* pickoffs);
 
   // t0 + n dt: counted, not summed, so 6e7 steps of 1e-5 s end at 600 s exactly.
   double time_s() const { return t0_s_ + static_cast<double>(steps_) * step_s_; }
@@ -111,6 +117,15 @@ class Resonator {
   using Mat42 = Eigen::Matrix<double, 4, 2>;
 
   void expand(double rate_rad_s, double omega_rad_s, double dt_s);
+  // The checks and updates step() makes before its product, for a rate and
+  // a mean frequency w: re-expansion, the <V^2> window, the rate propagator.
+  void prepare_step(double rate_rad_s, double w, double dt_s);
+  // The linear part of one step (propagator at the rate, forcers, pump
+  // and spring), the <V^2> history advanced by the drive's pump voltage.
+  Vec4 propagate(const Drive& drive);
+  // Whether step_block may take its held-inputs path; the rate and the
+  // temperature it holds when so.
+  bool inputs_held(std::size_t n, double dt_s, double& rate_rad_s, double& temp_c);
   double pump_delayed(double delay_samples) const;
   double push_pump(double pump_v);
   PickoffOutput measured_with_effects() const;
