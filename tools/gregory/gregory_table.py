@@ -17,7 +17,12 @@ readout error after calibration <= 0.01 deg on the pickoff rows; without
 calibration, no row reports a valid compensated output worse than raw.
 
 usage: gregory_table.py --hrg PATH --scenario default.toml [--rows a,b] [--jobs N]
-                        [--work DIR] [--check] [--goals full|loop]
+                        [--work DIR] [--check] [--goals full|loop] [--duration S]
+
+--jobs N: rows run in N worker threads, each driving its own hrg processes
+(default: every core); the rows are independent runs, so the table is the same
+for every N and printed in the same order. --duration S is passed to every
+hrg sim (default: the scenario's own length).
 """
 import argparse
 import concurrent.futures as cf
@@ -97,8 +102,10 @@ def readout_error_deg(telemetry):
     return worst
 
 
-def run_sim(hrg, scenario, out, calibration=None):
+def run_sim(hrg, scenario, out, calibration=None, duration=None):
     cmd = [hrg, "sim", "--scenario", scenario, "--out", out, "--no-plots", "--quiet"]
+    if duration is not None:
+        cmd += ["--duration", repr(duration)]
     if calibration:
         cmd += ["--calibration", calibration]
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -112,7 +119,7 @@ def run_sim(hrg, scenario, out, calibration=None):
             "readout": readout_error_deg(os.path.join(out, "telemetry.csv"))}
 
 
-def run_row(hrg, base, work, name):
+def run_row(hrg, base, work, name, duration=None):
     edits, _ = ROWS[name]
     text = open(base).read()
     for section, kv in edits.items():
@@ -122,14 +129,14 @@ def run_row(hrg, base, work, name):
     os.makedirs(d, exist_ok=True)
     scen = os.path.join(d, "scenario.toml")
     open(scen, "w").write(text)
-    before = run_sim(hrg, scen, os.path.join(d, "run0"))
+    before = run_sim(hrg, scen, os.path.join(d, "run0"), duration=duration)
     cal = os.path.join(d, "cal.toml")
     p = subprocess.run([hrg, "audit", os.path.join(d, "run0", "telemetry.csv"), "--calibration", cal],
                        capture_output=True, text=True)
     if not os.path.exists(cal):
         raise SystemExit("hrg audit wrote no calibration for %s:\n%s%s" % (name, p.stdout, p.stderr))
     verdict = next((l.split()[1] for l in p.stdout.splitlines() if l.startswith("VERDICT:")), "?")
-    after = run_sim(hrg, scen, os.path.join(d, "run1"), cal)
+    after = run_sim(hrg, scen, os.path.join(d, "run1"), cal, duration)
     return name, before, after, verdict
 
 
@@ -138,19 +145,26 @@ def main():
     ap.add_argument("--hrg", required=True)
     ap.add_argument("--scenario", required=True)
     ap.add_argument("--rows", default=",".join(ROWS))
-    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--work", default="gregory-work")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--goals", choices=["full", "loop"], default="full")
+    ap.add_argument("--duration", type=float, default=None)
     a = ap.parse_args()
+    if a.jobs < 1:
+        ap.error("--jobs must be at least 1 (got %d)" % a.jobs)
+    if a.duration is not None and not a.duration > 0:
+        ap.error("--duration must be positive (got %g)" % a.duration)
     names = a.rows.split(",")
     for n in names:
         if n not in ROWS:
             raise SystemExit("unknown row '%s' (rows: %s)" % (n, ", ".join(ROWS)))
     if "none" not in names:
         names = ["none"] + names
+    # map() returns the rows in the order asked, whichever finishes first.
     with cf.ThreadPoolExecutor(a.jobs) as ex:
-        res = {r[0]: r[1:] for r in ex.map(lambda n: run_row(a.hrg, a.scenario, a.work, n), names)}
+        res = {r[0]: r[1:] for r in ex.map(
+            lambda n: run_row(a.hrg, a.scenario, a.work, n, a.duration), names)}
     clean = res["none"][0]["comp"]
     print("| effect | raw | seed model | (valid) | after audit round | (valid) | clean | readout before | after | audit verdict | goals |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
