@@ -175,22 +175,13 @@ double Resonator::pump_delayed(double delay_samples) const {
   return (1.0 - frac) * at(whole) + frac * at(whole + 1);
 }
 
-double Resonator::push_pump(double pump_v) {
-  constexpr int kMask = kHistory - 1;  // kHistory is a power of two
-  hist_pos_ = (hist_pos_ + 1) & kMask;
-  const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_) & kMask];
-  pump_hist_[hist_pos_] = pump_v;
-  pump_sq_hist_[hist_pos_] = pump_v * pump_v;
-  if (hist_pos_ == 0 || !pump_sum_valid_) {
-    // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
-    pump_sq_sum_ = 0.0;
-    for (int i = 0; i < avg_len_; ++i)
-      pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
-    pump_sum_valid_ = true;
-  } else {
-    pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
-  }
-  return pump_sq_sum_ / avg_len_;
+void Resonator::readd_pump_squares() {
+  // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
+  constexpr int kMask = kHistory - 1;
+  pump_sq_sum_ = 0.0;
+  for (int i = 0; i < avg_len_; ++i)
+    pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
+  pump_sum_valid_ = true;
 }
 
 void Resonator::prepare_step(double rate_rad_s, double w, double dt_s) {
@@ -212,19 +203,6 @@ void Resonator::prepare_step(double rate_rad_s, double w, double dt_s) {
     rate_prop_d_ = d_rate;
     rate_prop_valid_ = true;
   }
-}
-
-inline Resonator::Vec4 Resonator::propagate(const Drive& drive) {
-  // Pump history: <V^2> over one reference period (the DC part of V^2).
-  const double v2_dc = push_pump(drive.pump_v);
-  // [propagator u; pump sensitivity u] in one 8x4 product.
-  const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u_;
-  Vec4 next = terms.head<4>();
-  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
-  const double v2 = drive.pump_v * drive.pump_v;
-  const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k_ * v2_dc;
-  next += c_gap * terms.tail<4>();
-  return next;
 }
 
 void Resonator::step(const Drive& drive, double dt_s) {
@@ -283,31 +261,10 @@ bool Resonator::inputs_held(std::size_t n, double dt_s, double& rate_rad_s, doub
          temp_at_.constant_over(t_first, t_last, temp_c);
 }
 
-void Resonator::step_block(const Drive* drives, std::size_t n, double dt_s,
-                           PickoffOutput* pickoffs) {
-  double rate = 0.0;
-  double temp_c = 0.0;
-  if (!inputs_held(n, dt_s, rate, temp_c)) {
-    for (std::size_t k = 0; k < n; ++k) {
-      pickoffs[k] = measured();
-      step(drives[k], dt_s);
-    }
-    return;
-  }
+Resonator::HeldCoefficients Resonator::prepare_held(double rate_rad_s, double temp_c, double dt_s) {
   const double w = detail::thermal_omega(params_, effects_, temp_c);
-  prepare_step(rate, w, dt_s);
-  // What step() computes per step, here once: no energy term is on.
-  const double c_iso = w * w - omega_c_ * omega_c_;
-  const double c_damp = detail::damping_scale(params_, effects_, temp_c, 0.0) - 1.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    pickoffs[k] = measured();
-    Vec4 next = propagate(drives[k]);
-    if (c_iso != 0.0) next.noalias() += psi_iso_ * (c_iso * u_);
-    if (c_damp != 0.0) next.noalias() += psi_damp_ * (c_damp * u_);
-    u_ = next;
-    ++steps_;
-  }
-  cursor_steps_ = steps_ - 1;
+  prepare_step(rate_rad_s, w, dt_s);
+  return {w * w - omega_c_ * omega_c_, detail::damping_scale(params_, effects_, temp_c, 0.0) - 1.0};
 }
 
 PickoffOutput Resonator::measured_with_effects() const {

@@ -161,13 +161,32 @@ class StageLaps {
 }  // namespace
 
 void SimTarget::run_resonator(std::size_t n, double dt) {
-  resonator_.step_block(drives_.data(), n, dt, pickoffs_.data());
   const double offset_x = config_.adc.offset_v[0];
   const double offset_y = config_.adc.offset_v[1];
-  for (std::size_t k = 0; k < n; ++k) {
-    volts_[2 * k] = pickoffs_[k].x_v + offset_x;
-    volts_[2 * k + 1] = pickoffs_[k].y_v + offset_y;
-  }
+  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
+    volts_[2 * k] = p.x_v + offset_x;
+    volts_[2 * k + 1] = p.y_v + offset_y;
+  });
+}
+
+uint32_t SimTarget::run_fused(std::size_t n, double dt, hal::q31_t* out) {
+  const double offset_x = config_.adc.offset_v[0];
+  const double offset_y = config_.adc.offset_v[1];
+  const auto& rms = config_.adc.noise_v_rms;
+  const bool noisy = rms[0] != 0.0 || rms[1] != 0.0;
+  uint32_t clipped = 0;
+  // The noise draws in the order fill() gives them (x, y per sample).
+  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
+    double x_v = p.x_v + offset_x;
+    double y_v = p.y_v + offset_y;
+    if (noisy) {
+      x_v += rms[0] * noise_.normal();
+      y_v += rms[1] * noise_.normal();
+    }
+    clipped += quantize_sample(0, x_v, out[2 * k]);
+    clipped += quantize_sample(1, y_v, out[2 * k + 1]);
+  });
+  return clipped;
 }
 
 void SimTarget::add_noise(std::size_t n, double dt) {
@@ -189,18 +208,8 @@ void SimTarget::add_noise(std::size_t n, double dt) {
 uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
   uint32_t clipped = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch) {
-      bool clip = false;
-      hal::q31_t word = adc_q_.convert(volts_[2 * k + ch], clip);
-      if (adc_saturated_[ch]) word = adc_q_.convert(1e300, clip);
-      if (adc_stuck_[ch]) {
-        word = adc_last_[ch];
-        clip = false;
-      }
-      adc_last_[ch] = word;
-      if (clip) ++clipped;
-      out[2 * k + ch] = word;
-    }
+    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch)
+      clipped += quantize_sample(ch, volts_[2 * k + ch], out[2 * k + ch]);
   }
   return clipped;
 }
@@ -216,15 +225,22 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   const double t0 = time_s();
   t_first_ns = sample_time_ns(sample_index_);
   clipped = 0;
-  // In chunks of kChunk samples, stage by stage: the DAC's drives, the
-  // resonator (pickoffs at t_k, then one step under drive k), the pickoff
-  // noise in one draw, the ADC. Sample k sees the same inputs as when the
-  // stages were interleaved per sample.
+  // In chunks of kChunk samples: the DAC's drives, then the resonator
+  // (pickoffs at t_k, then one step under drive k), the pickoff noise and
+  // the ADC. Without a noise burst or profiling the last three run in one
+  // loop, where the noise and the ADC overlap the step's dependency chain;
+  // otherwise stage by stage, to time each stage. Both give sample k the
+  // same inputs and the same bits.
   for (std::size_t done = 0; done < n; done += kChunk) {
     const std::size_t m = std::min<std::size_t>(kChunk, n - done);
     for (std::size_t k = 0; k < m; ++k)
       drives_[k] = next_drive();
     last_pump_v_ = drives_[m - 1].pump_v;
+    if (!profiling_ && !(burst_left_s_ > 0.0)) {
+      clipped += run_fused(m, dt, frames.data() + 2 * done);
+      sample_index_ += m;
+      continue;
+    }
     laps.lap(&SimStageTimes::dac_ns);
     run_resonator(m, dt);
     sample_index_ += m;

@@ -199,7 +199,8 @@ TEST(Resonator, StepBlockGivesTheBitsOfStepByStep) {
       const double t = (block * 100.0 + static_cast<double>(k)) * kDt;
       drives[k] = {2.0 + std::cos(4e4 * t), 0.01 * std::sin(3e4 * t), 0.0};
     }
-    b.step_block(drives.data(), drives.size(), kDt, got.data());
+    b.step_block(drives.data(), drives.size(), kDt,
+                 [&got](std::size_t k, const PickoffOutput& out) { got[k] = out; });
     for (std::size_t k = 0; k < drives.size(); ++k) {
       const PickoffOutput want = a.measured();
       CHECK_EQUAL(want.x_v, got[k].x_v);

@@ -136,6 +136,21 @@ class SimTarget {
   void run_resonator(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   uint32_t quantize(std::size_t n, hal::q31_t* out);
+  // Resonator, noise and ADC in one loop (no burst on); returns the clipped count.
+  uint32_t run_fused(std::size_t n, double dt, hal::q31_t* out);
+  // One ADC conversion with the channel's faults; 1 when it clipped.
+  uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {
+    bool clip = false;
+    hal::q31_t word = adc_q_.convert(v, clip);
+    if (adc_saturated_[ch]) word = adc_q_.convert(1e300, clip);
+    if (adc_stuck_[ch]) {
+      word = adc_last_[ch];
+      clip = false;
+    }
+    adc_last_[ch] = word;
+    out = word;
+    return clip ? 1u : 0u;
+  }
   Drive next_drive();
   uint64_t sample_time_ns(uint64_t index) const;
 
@@ -174,7 +189,6 @@ class SimTarget {
   bool profiling_ = false;
   SimStageTimes stage_times_;
   std::array<Drive, kChunk> drives_{};
-  std::array<PickoffOutput, kChunk> pickoffs_{};
   std::array<double, 2 * kChunk> volts_{};
   std::array<double, 2 * kChunk> noise_buf_{};
 };
