@@ -111,30 +111,36 @@ TrueState SimTarget::true_state() const {
   return s;
 }
 
-Drive SimTarget::next_drive() {
-  // Double buffer: a frame the firmware queued, or zero when none is waiting.
-  DacFrame frame{};
-  if (dac_head_ < dac_queue_.size()) {
-    frame = dac_queue_[dac_head_++];
-    if (dac_head_ == dac_queue_.size()) {
-      dac_queue_.clear();
-      dac_head_ = 0;
+void SimTarget::fill_drives(std::size_t m) {
+  // Double buffer: the frames the firmware queued, then zeros when none is
+  // waiting (an underrun once the firmware has written).
+  const std::size_t queued = std::min(dac_queue_.size() - dac_head_, m);
+  const DacFrame* from_queue = dac_queue_.data() + dac_head_;
+  if (queued < m && dac_written_) counters_.dac_underruns += m - queued;
+  const std::size_t latency = dac_latency_.size();
+  const bool on = excitation_.value;
+  uint64_t saturated = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    DacFrame frame = k < queued ? from_queue[k] : DacFrame{};
+    if (latency != 0) {
+      std::swap(frame, dac_latency_[latency_pos_]);
+      if (++latency_pos_ == latency) latency_pos_ = 0;
     }
-  } else if (dac_written_) {
-    ++counters_.dac_underruns;
+    std::array<double, hal::kDacChannels> v{};
+    for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
+      bool rail = false;
+      v[ch] = dac_q_.convert(frame[ch], rail);
+      saturated += rail ? 1 : 0;
+      if (dac_dead_[ch] || !on) v[ch] = 0.0;
+    }
+    drives_[k] = Drive{v[0], v[1], v[2]};
   }
-  if (!dac_latency_.empty()) {
-    std::swap(frame, dac_latency_[latency_pos_]);
-    if (++latency_pos_ == dac_latency_.size()) latency_pos_ = 0;
+  counters_.dac_saturated += saturated;
+  dac_head_ += queued;
+  if (dac_head_ == dac_queue_.size()) {
+    dac_queue_.clear();
+    dac_head_ = 0;
   }
-  std::array<double, hal::kDacChannels> v{};
-  for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
-    bool saturated = false;
-    v[ch] = dac_q_.convert(frame[ch], saturated);
-    if (saturated) ++counters_.dac_saturated;
-    if (dac_dead_[ch] || !excitation_.value) v[ch] = 0.0;
-  }
-  return Drive{v[0], v[1], v[2]};
 }
 
 namespace {
@@ -233,8 +239,7 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   // same inputs and the same bits.
   for (std::size_t done = 0; done < n; done += kChunk) {
     const std::size_t m = std::min<std::size_t>(kChunk, n - done);
-    for (std::size_t k = 0; k < m; ++k)
-      drives_[k] = next_drive();
+    fill_drives(m);
     last_pump_v_ = drives_[m - 1].pump_v;
     if (!profiling_ && !(burst_left_s_ > 0.0)) {
       clipped += run_fused(m, dt, frames.data() + 2 * done);

@@ -151,7 +151,8 @@ class SimTarget {
     out = word;
     return clip ? 1u : 0u;
   }
-  Drive next_drive();
+  // drives_[0..m): the DAC's next m frames through its latency line and quantisers.
+  void fill_drives(std::size_t m);
   uint64_t sample_time_ns(uint64_t index) const;
 
   SimConfig config_;

@@ -145,7 +145,7 @@ class Resonator {
   void prepare_step(double rate_rad_s, double w, double dt_s);
   // The linear part of one step (propagator at the rate, forcers, pump
   // and spring), the <V^2> history advanced by the drive's pump voltage.
-  Vec4 propagate(const Drive& drive) {
+  [[gnu::always_inline]] Vec4 propagate(const Drive& drive) {
     // Pump history: <V^2> over one reference period (the DC part of V^2).
     const double v2_dc = push_pump(drive.pump_v);
     // [propagator u; pump sensitivity u] in one 8x4 product.
