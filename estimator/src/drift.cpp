@@ -137,6 +137,7 @@ void PumpDriftEstimator::fold_segment() {
     fit_s_ = decay * fit_s_ + (t_last_s_ - t0_s_);
     t_last_fold_s_ = t_last_s_;
     have_fold_ = true;
+    refresh_fit();
   }
   started_ = false;
   seg_s_.setZero();
@@ -189,24 +190,25 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
   return true;
 }
 
-double PumpDriftEstimator::kappa_2() const {
+void PumpDriftEstimator::refresh_fit() {
   const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
-  return conditioning_of<3>(n).kappa_2;
-}
-
-bool PumpDriftEstimator::valid() const {
-  if (fit_s_ < config_.min_fit_s) return false;
-  return kappa_2() <= config_.max_kappa_2;
-}
-
-Eigen::Vector3d PumpDriftEstimator::coefficients() const {
-  if (!valid()) return Eigen::Vector3d::Zero();
-  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  kappa_2_ = conditioning_of<3>(n).kappa_2;
+  coefficients_.setZero();
+  if (!valid()) return;
   const Eigen::Vector3d b = m_.topRightCorner<3, 1>();
   const Eigen::Vector3d s = n.diagonal().cwiseSqrt().cwiseInverse();
   const Eigen::Matrix3d a = s.asDiagonal() * n * s.asDiagonal();
-  return s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * b);
+  coefficients_ = s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * b);
 }
+
+double PumpDriftEstimator::kappa_2() const { return kappa_2_; }
+
+bool PumpDriftEstimator::valid() const {
+  if (fit_s_ < config_.min_fit_s) return false;
+  return kappa_2_ <= config_.max_kappa_2;
+}
+
+Eigen::Vector3d PumpDriftEstimator::coefficients() const { return coefficients_; }
 
 double PumpDriftEstimator::d_phi_rad_s(double theta_A_rad) const {
   const Eigen::Vector3d c = coefficients();

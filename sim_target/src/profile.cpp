@@ -194,6 +194,18 @@ double ProfileCursor::value_searched(double t_s, bool next_step, double step_s) 
   return p.offset_;
 }
 
+bool ProfileCursor::constant_over(double t0_s, double t1_s, double& value) {
+  const Profile& p = *p_;
+  if (p.kind_ == Profile::Kind::sine) return false;
+  value = this->value(t0_s, false, 0.0);  // steps and ramps: finds the segment
+  if (p.kind_ == Profile::Kind::constant) return true;
+  if (!(t1_s < hi_s_)) return false;
+  if (p.kind_ == Profile::Kind::steps) return true;
+  // A ramp segment between equal values: a + u (b - a) = a for every u.
+  const auto& pts = p.points_;
+  return segment_ == 0 || segment_ == pts.size() || pts[segment_ - 1].value == pts[segment_].value;
+}
+
 double ProfileCursor::sine_value(double t_s, bool next_step, double step_s) {
   const Profile& p = *p_;
   const double w = 2.0 * std::numbers::pi * p.freq_hz_;

@@ -175,22 +175,34 @@ double Resonator::pump_delayed(double delay_samples) const {
   return (1.0 - frac) * at(whole) + frac * at(whole + 1);
 }
 
-double Resonator::push_pump(double pump_v) {
-  constexpr int kMask = kHistory - 1;  // kHistory is a power of two
-  hist_pos_ = (hist_pos_ + 1) & kMask;
-  const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_) & kMask];
-  pump_hist_[hist_pos_] = pump_v;
-  pump_sq_hist_[hist_pos_] = pump_v * pump_v;
-  if (hist_pos_ == 0 || !pump_sum_valid_) {
-    // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
-    pump_sq_sum_ = 0.0;
-    for (int i = 0; i < avg_len_; ++i)
-      pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
-    pump_sum_valid_ = true;
-  } else {
-    pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
+void Resonator::readd_pump_squares() {
+  // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
+  constexpr int kMask = kHistory - 1;
+  pump_sq_sum_ = 0.0;
+  for (int i = 0; i < avg_len_; ++i)
+    pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
+  pump_sum_valid_ = true;
+}
+
+void Resonator::prepare_step(double rate_rad_s, double w, double dt_s) {
+  if (!expanded_ || dt_s != dt_c_ || std::abs(rate_rad_s - rate_c_) > kRateReexpandRadS ||
+      std::abs(w - omega_c_) > kOmegaReexpandRadS) {
+    expand(rate_rad_s, w, dt_s);
   }
-  return pump_sq_sum_ / avg_len_;
+  if (dt_s != dt_last_) {
+    dt_last_ = dt_s;
+    avg_len_ = std::max(
+        1, std::min(kHistory - 1, static_cast<int>(std::lround(1.0 / (f_ref_hz_ * dt_s)))));
+    pump_sum_valid_ = false;
+  }
+  // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only
+  // when the rate changes (every step of a ramp, once per hold).
+  const double d_rate = rate_rad_s - rate_c_;
+  if (!rate_prop_valid_ || d_rate != rate_prop_d_) {
+    rate_gap_.topRows<4>() = phi_ + d_rate * psi_rate1_ + (d_rate * d_rate) * psi_rate2_;
+    rate_prop_d_ = d_rate;
+    rate_prop_valid_ = true;
+  }
 }
 
 void Resonator::step(const Drive& drive, double dt_s) {
@@ -207,19 +219,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   const double rate = rate_at_.value(t_mid, next_step, dt_s);
   const double temp_c = temp_at_.value(t_mid, next_step, dt_s);
   const double w = detail::thermal_omega(params_, effects_, temp_c);
-  if (!expanded_ || dt_s != dt_c_ || std::abs(rate - rate_c_) > kRateReexpandRadS ||
-      std::abs(w - omega_c_) > kOmegaReexpandRadS) {
-    expand(rate, w, dt_s);
-  }
-  if (dt_s != dt_last_) {
-    dt_last_ = dt_s;
-    avg_len_ = std::max(
-        1, std::min(kHistory - 1, static_cast<int>(std::lround(1.0 / (f_ref_hz_ * dt_s)))));
-    pump_sum_valid_ = false;
-  }
-
-  // Pump history: <V^2> over one reference period (the DC part of V^2).
-  const double v2_dc = push_pump(drive.pump_v);
+  prepare_step(rate, w, dt_s);
 
   // E = x^2 + y^2 + (x'^2 + y'^2)/w^2, needed only by the amplitude-dependent effects.
   const bool needs_energy =
@@ -227,21 +227,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   const double energy =
       needs_energy ? u_(0) * u_(0) + u_(1) * u_(1) + (u_(2) * u_(2) + u_(3) * u_(3)) / (w * w)
                    : 0.0;
-  // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only
-  // when the rate changes (every step of a ramp, once per hold); then
-  // [that propagator u; pump sensitivity u] in one 8x4 product.
-  const double d_rate = rate - rate_c_;
-  if (!rate_prop_valid_ || d_rate != rate_prop_d_) {
-    rate_gap_.topRows<4>() = phi_ + d_rate * psi_rate1_ + (d_rate * d_rate) * psi_rate2_;
-    rate_prop_d_ = d_rate;
-    rate_prop_valid_ = true;
-  }
-  const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u_;
-  Vec4 next = terms.head<4>();
-  next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
-  const double v2 = drive.pump_v * drive.pump_v;
-  const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k_ * v2_dc;
-  next += c_gap * terms.tail<4>();
+  Vec4 next = propagate(drive);
 
   double c_iso = w * w - omega_c_ * omega_c_;
   if (effects_.duffing_stiffness.enabled) {
@@ -261,6 +247,24 @@ void Resonator::step(const Drive& drive, double dt_s) {
 
   u_ = next;
   ++steps_;
+}
+
+bool Resonator::inputs_held(std::size_t n, double dt_s, double& rate_rad_s, double& temp_c) {
+  if (n == 0 || dt_s != step_s_ || dt_s != dt_last_) return false;
+  if (effects_.duffing_stiffness.enabled || effects_.nonlinear_damping.enabled) return false;
+  if (rate_at_.profile() != &rate_) rate_at_.bind(&rate_);
+  if (temp_at_.profile() != &temp_) temp_at_.bind(&temp_);
+  // The step midpoints as step() computes them.
+  const double t_first = t0_s_ + static_cast<double>(steps_) * step_s_ + 0.5 * dt_s;
+  const double t_last = t0_s_ + static_cast<double>(steps_ + n - 1) * step_s_ + 0.5 * dt_s;
+  return rate_at_.constant_over(t_first, t_last, rate_rad_s) &&
+         temp_at_.constant_over(t_first, t_last, temp_c);
+}
+
+Resonator::HeldCoefficients Resonator::prepare_held(double rate_rad_s, double temp_c, double dt_s) {
+  const double w = detail::thermal_omega(params_, effects_, temp_c);
+  prepare_step(rate_rad_s, w, dt_s);
+  return {w * w - omega_c_ * omega_c_, detail::damping_scale(params_, effects_, temp_c, 0.0) - 1.0};
 }
 
 PickoffOutput Resonator::measured_with_effects() const {

@@ -111,30 +111,36 @@ TrueState SimTarget::true_state() const {
   return s;
 }
 
-Drive SimTarget::next_drive() {
-  // Double buffer: a frame the firmware queued, or zero when none is waiting.
-  DacFrame frame{};
-  if (dac_head_ < dac_queue_.size()) {
-    frame = dac_queue_[dac_head_++];
-    if (dac_head_ == dac_queue_.size()) {
-      dac_queue_.clear();
-      dac_head_ = 0;
+void SimTarget::fill_drives(std::size_t m) {
+  // Double buffer: the frames the firmware queued, then zeros when none is
+  // waiting (an underrun once the firmware has written).
+  const std::size_t queued = std::min(dac_queue_.size() - dac_head_, m);
+  const DacFrame* from_queue = dac_queue_.data() + dac_head_;
+  if (queued < m && dac_written_) counters_.dac_underruns += m - queued;
+  const std::size_t latency = dac_latency_.size();
+  const bool on = excitation_.value;
+  uint64_t saturated = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    DacFrame frame = k < queued ? from_queue[k] : DacFrame{};
+    if (latency != 0) {
+      std::swap(frame, dac_latency_[latency_pos_]);
+      if (++latency_pos_ == latency) latency_pos_ = 0;
     }
-  } else if (dac_written_) {
-    ++counters_.dac_underruns;
+    std::array<double, hal::kDacChannels> v{};
+    for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
+      bool rail = false;
+      v[ch] = dac_q_.convert(frame[ch], rail);
+      saturated += rail ? 1 : 0;
+      if (dac_dead_[ch] || !on) v[ch] = 0.0;
+    }
+    drives_[k] = Drive{v[0], v[1], v[2]};
   }
-  if (!dac_latency_.empty()) {
-    std::swap(frame, dac_latency_[latency_pos_]);
-    if (++latency_pos_ == dac_latency_.size()) latency_pos_ = 0;
+  counters_.dac_saturated += saturated;
+  dac_head_ += queued;
+  if (dac_head_ == dac_queue_.size()) {
+    dac_queue_.clear();
+    dac_head_ = 0;
   }
-  std::array<double, hal::kDacChannels> v{};
-  for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
-    bool saturated = false;
-    v[ch] = dac_q_.convert(frame[ch], saturated);
-    if (saturated) ++counters_.dac_saturated;
-    if (dac_dead_[ch] || !excitation_.value) v[ch] = 0.0;
-  }
-  return Drive{v[0], v[1], v[2]};
 }
 
 namespace {
@@ -161,12 +167,32 @@ class StageLaps {
 }  // namespace
 
 void SimTarget::run_resonator(std::size_t n, double dt) {
-  for (std::size_t k = 0; k < n; ++k) {
-    const PickoffOutput p = resonator_.measured();
-    volts_[2 * k] = p.x_v + config_.adc.offset_v[0];
-    volts_[2 * k + 1] = p.y_v + config_.adc.offset_v[1];
-    resonator_.step(drives_[k], dt);
-  }
+  const double offset_x = config_.adc.offset_v[0];
+  const double offset_y = config_.adc.offset_v[1];
+  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
+    volts_[2 * k] = p.x_v + offset_x;
+    volts_[2 * k + 1] = p.y_v + offset_y;
+  });
+}
+
+uint32_t SimTarget::run_fused(std::size_t n, double dt, hal::q31_t* out) {
+  const double offset_x = config_.adc.offset_v[0];
+  const double offset_y = config_.adc.offset_v[1];
+  const auto& rms = config_.adc.noise_v_rms;
+  const bool noisy = rms[0] != 0.0 || rms[1] != 0.0;
+  uint32_t clipped = 0;
+  // The noise draws in the order fill() gives them (x, y per sample).
+  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
+    double x_v = p.x_v + offset_x;
+    double y_v = p.y_v + offset_y;
+    if (noisy) {
+      x_v += rms[0] * noise_.normal();
+      y_v += rms[1] * noise_.normal();
+    }
+    clipped += quantize_sample(0, x_v, out[2 * k]);
+    clipped += quantize_sample(1, y_v, out[2 * k + 1]);
+  });
+  return clipped;
 }
 
 void SimTarget::add_noise(std::size_t n, double dt) {
@@ -188,18 +214,8 @@ void SimTarget::add_noise(std::size_t n, double dt) {
 uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
   uint32_t clipped = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch) {
-      bool clip = false;
-      hal::q31_t word = adc_q_.convert(volts_[2 * k + ch], clip);
-      if (adc_saturated_[ch]) word = adc_q_.convert(1e300, clip);
-      if (adc_stuck_[ch]) {
-        word = adc_last_[ch];
-        clip = false;
-      }
-      adc_last_[ch] = word;
-      if (clip) ++clipped;
-      out[2 * k + ch] = word;
-    }
+    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch)
+      clipped += quantize_sample(ch, volts_[2 * k + ch], out[2 * k + ch]);
   }
   return clipped;
 }
@@ -215,15 +231,21 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   const double t0 = time_s();
   t_first_ns = sample_time_ns(sample_index_);
   clipped = 0;
-  // In chunks of kChunk samples, stage by stage: the DAC's drives, the
-  // resonator (pickoffs at t_k, then one step under drive k), the pickoff
-  // noise in one draw, the ADC. Sample k sees the same inputs as when the
-  // stages were interleaved per sample.
+  // In chunks of kChunk samples: the DAC's drives, then the resonator
+  // (pickoffs at t_k, then one step under drive k), the pickoff noise and
+  // the ADC. Without a noise burst or profiling the last three run in one
+  // loop, where the noise and the ADC overlap the step's dependency chain;
+  // otherwise stage by stage, to time each stage. Both give sample k the
+  // same inputs and the same bits.
   for (std::size_t done = 0; done < n; done += kChunk) {
     const std::size_t m = std::min<std::size_t>(kChunk, n - done);
-    for (std::size_t k = 0; k < m; ++k)
-      drives_[k] = next_drive();
+    fill_drives(m);
     last_pump_v_ = drives_[m - 1].pump_v;
+    if (!profiling_ && !(burst_left_s_ > 0.0)) {
+      clipped += run_fused(m, dt, frames.data() + 2 * done);
+      sample_index_ += m;
+      continue;
+    }
     laps.lap(&SimStageTimes::dac_ns);
     run_resonator(m, dt);
     sample_index_ += m;

@@ -54,3 +54,25 @@ TEST(ProfileCursor, SineByRotationStaysWithinItsBoundOverOneHour) {
   CHECK(worst <= bound);
   CHECK(worst > 0.0);  // the rotation is really used (an exact sin would give 0)
 }
+
+TEST(ProfileCursor, ConstantOverHoldsOnlyWhereTheValueCannotChange) {
+  const Profile ramps = Profile::ramps({{0.5, 0.0}, {2.0, 4.0}, {3.0, 4.0}, {3.5, -1.0}});
+  const Profile steps = Profile::steps({{1.0, 2.0}, {3.0, -1.0}});
+  const Profile sine = Profile::sine(1.0, 1.0, 0.0);
+  ProfileCursor r(&ramps);
+  ProfileCursor s(&steps);
+  ProfileCursor c(&sine);
+  double v = 0.0;
+  CHECK_TRUE(r.constant_over(0.0, 0.4, v));  // before the first point
+  CHECK_EQUAL(ramps.value(0.2), v);
+  CHECK_FALSE(r.constant_over(0.6, 0.7, v));  // rising segment
+  CHECK_TRUE(r.constant_over(2.1, 2.9, v));   // flat segment between equal values
+  CHECK_EQUAL(ramps.value(2.5), v);
+  CHECK_FALSE(r.constant_over(2.9, 3.1, v));  // across a breakpoint
+  CHECK_TRUE(r.constant_over(3.6, 1e4, v));   // after the last point
+  CHECK_EQUAL(ramps.value(100.0), v);
+  CHECK_TRUE(s.constant_over(1.0, 2.999, v));
+  CHECK_EQUAL(2.0, v);
+  CHECK_FALSE(s.constant_over(2.0, 3.0, v));  // the jump at 3 s is inside
+  CHECK_FALSE(c.constant_over(0.0, 1e-5, v));
+}

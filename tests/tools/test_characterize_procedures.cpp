@@ -174,3 +174,18 @@ TEST(Procedures, BiasAgainstTemperatureFollowsTheDamping) {
   CHECK(std::fabs(d.temperature_model_dph) > 5.0);  // the ramp's angle has a drift to scale
   DOUBLES_EQUAL(expected, d.temperature_raw.slope_per_degc, 0.1 * std::fabs(expected));
 }
+
+TEST(Procedures, TurnOnsInParallelGiveTheBiasesOfOneAtATime) {
+  ProcedureOptions o = short_options();
+  o.jobs = 1;
+  const DriftResult one = run_bias_repeatability(o);
+  o.jobs = 2;
+  const DriftResult two = run_bias_repeatability(o);
+  LONGS_EQUAL(2, one.turn_on_bias_dph.size());
+  LONGS_EQUAL(2, two.turn_on_bias_dph.size());
+  for (std::size_t i = 0; i < one.turn_on_bias_dph.size(); ++i)
+    CHECK_EQUAL(one.turn_on_bias_dph[i], two.turn_on_bias_dph[i]);
+  // Different seeds: the turn-ons are not one run twice.
+  CHECK(one.turn_on_bias_dph[0] != one.turn_on_bias_dph[1]);
+  CHECK_EQUAL(one.sim_s, two.sim_s);
+}

@@ -21,7 +21,12 @@ the next power-up <= 2x clean on the gain and misalignment rows; without
 calibration, no row reports a valid compensated output worse than raw.
 
 usage: gregory_table.py --hrg PATH --scenario default.toml [--rows a,b] [--jobs N]
-                        [--work DIR] [--check] [--goals full|loop]
+                        [--work DIR] [--check] [--goals full|loop] [--duration S]
+
+--jobs N: rows run in N worker threads, each driving its own hrg processes
+(default: every core); the rows are independent runs, so the table is the same
+for every N and printed in the same order. --duration S is passed to every
+hrg sim (default: the scenario's own length).
 """
 import argparse
 import concurrent.futures as cf
@@ -107,8 +112,10 @@ def readout_error_deg(telemetry):
     return worst
 
 
-def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False):
+def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration=None):
     cmd = [hrg, "sim", "--scenario", scenario, "--out", out, "--no-plots", "--quiet"]
+    if duration is not None:
+        cmd += ["--duration", repr(duration)]
     if calibration:
         cmd += ["--calibration", calibration]
     if self_calibrate:
@@ -126,7 +133,7 @@ def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False):
             "readout": readout_error_deg(os.path.join(out, "telemetry.csv"))}
 
 
-def run_row(hrg, base, work, name):
+def run_row(hrg, base, work, name, duration=None):
     edits, _ = ROWS[name]
     text = open(base).read()
     for section, kv in edits.items():
@@ -136,15 +143,16 @@ def run_row(hrg, base, work, name):
     os.makedirs(d, exist_ok=True)
     scen = os.path.join(d, "scenario.toml")
     open(scen, "w").write(text)
-    before = run_sim(hrg, scen, os.path.join(d, "run0"))
+    before = run_sim(hrg, scen, os.path.join(d, "run0"), duration=duration)
     cal = os.path.join(d, "cal.toml")
     p = subprocess.run([hrg, "audit", os.path.join(d, "run0", "telemetry.csv"), "--calibration", cal],
                        capture_output=True, text=True)
     if not os.path.exists(cal):
         raise SystemExit("hrg audit wrote no calibration for %s:\n%s%s" % (name, p.stdout, p.stderr))
     verdict = next((l.split()[1] for l in p.stdout.splitlines() if l.startswith("VERDICT:")), "?")
-    after = run_sim(hrg, scen, os.path.join(d, "run1"), cal)
-    online = run_sim(hrg, scen, os.path.join(d, "online"), self_calibrate=True)
+    after = run_sim(hrg, scen, os.path.join(d, "run1"), cal, duration=duration)
+    online = run_sim(hrg, scen, os.path.join(d, "online"), self_calibrate=True,
+                     duration=duration)
     # What the firmware identified online, in force from the next power-up
     # (as a board keeps it): only what it put in force, the pickoff map.
     f = online["in_force"]
@@ -152,7 +160,7 @@ def run_row(hrg, base, work, name):
     open(own, "w").write("calibration_format = 1\npickoff_y_gain = %.17g\n"
                          "pickoff_y_misalignment_deg = %.17g\n" % (
                              f.get("pickoff_y_gain", 0.0), f.get("pickoff_y_misalignment_deg", 0.0)))
-    reboot = run_sim(hrg, scen, os.path.join(d, "online_reboot"), own)
+    reboot = run_sim(hrg, scen, os.path.join(d, "online_reboot"), own, duration=duration)
     return name, before, after, verdict, online, reboot
 
 
@@ -161,19 +169,26 @@ def main():
     ap.add_argument("--hrg", required=True)
     ap.add_argument("--scenario", required=True)
     ap.add_argument("--rows", default=",".join(ROWS))
-    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--work", default="gregory-work")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--goals", choices=["full", "loop"], default="full")
+    ap.add_argument("--duration", type=float, default=None)
     a = ap.parse_args()
+    if a.jobs < 1:
+        ap.error("--jobs must be at least 1 (got %d)" % a.jobs)
+    if a.duration is not None and not a.duration > 0:
+        ap.error("--duration must be positive (got %g)" % a.duration)
     names = a.rows.split(",")
     for n in names:
         if n not in ROWS:
             raise SystemExit("unknown row '%s' (rows: %s)" % (n, ", ".join(ROWS)))
     if "none" not in names:
         names = ["none"] + names
+    # map() returns the rows in the order asked, whichever finishes first.
     with cf.ThreadPoolExecutor(a.jobs) as ex:
-        res = {r[0]: r[1:] for r in ex.map(lambda n: run_row(a.hrg, a.scenario, a.work, n), names)}
+        res = {r[0]: r[1:] for r in ex.map(
+            lambda n: run_row(a.hrg, a.scenario, a.work, n, a.duration), names)}
     clean = res["none"][0]["comp"]
     print("| effect | raw | seed model | (valid) | online in run | (valid, rounds) | online at next power-up | after audit round | (valid) | clean | readout before | after | audit verdict | goals |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")

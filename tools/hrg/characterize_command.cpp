@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "batch/batch.hpp"
 #include "characterize/procedures.hpp"
 
 namespace hrg::cli {
@@ -21,7 +22,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: hrg characterize --test NAME|all [--test NAME ...] [--out DIR]\n"
     "                        [--scenario FILE] [--turn-ons N] [--short] [--no-render]\n"
-    "                        [--quiet]\n\n"
+    "                        [--jobs N] [--quiet]\n\n"
     "Runs the firmware on the simulated target (the runner of `hrg sim`) through\n"
     "the test procedures and writes the data sheet: DIR/datasheet.json, and from\n"
     "it DIR/summary.txt and a self-contained DIR/report.html (default DIR:\n"
@@ -36,7 +37,9 @@ constexpr const char* kUsage =
     "  rundown       IEEE 1431 12.13/12.14: excitation off, free decay, run-down\n"
     "--scenario takes a TOML scenario with a constant rate (the Earth rate).\n"
     "--short: shorter records (the CTest). --turn-ons N: bias repeatability runs\n"
-    "(default 3). Exit status: 0 done, 2 bad usage or input.\n";
+    "(default 3). --jobs N: independent runs (the turn-ons) N at a time, default\n"
+    "every core; the data sheet is the same for every N.\n"
+    "Exit status: 0 done, 2 bad usage or input.\n";
 
 std::filesystem::path datasheet_script() {
   if (const char* env = std::getenv("HRG_DATASHEET_SCRIPT")) return env;
@@ -63,6 +66,14 @@ int parse(std::span<char* const> args, Args& a) {
     if (arg == "--help" || arg == "-h") {
       std::fputs(kUsage, stdout);
       return 1;
+    } else if (arg == "--jobs") {
+      if ((v = value()) == nullptr) return 2;
+      if (!batch::parse_jobs(v, a.options.jobs)) {
+        std::fprintf(stderr,
+                     "hrg characterize: --jobs '%s' must be a positive integer (0: every core)\n",
+                     v);
+        return 2;
+      }
     } else if (arg == "--test" || arg == "--out" || arg == "--scenario" || arg == "--turn-ons") {
       if ((v = value()) == nullptr) return 2;
       if (arg == "--test") a.tests.emplace_back(v);

@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include <estimator/types.hpp>
 
@@ -227,6 +228,10 @@ class PumpDriftEstimator {
   using Vec4 = Eigen::Matrix<double, 4, 1>;
   using Mat4 = Eigen::Matrix<double, 4, 4>;
   void fold_segment();
+  // The fit's derived figures, recomputed only when m_ changes (a fold): the
+  // control-rate task asks for them every sample and an eigen-solve each time
+  // cost more than the rest of the estimator.
+  void refresh_fit();
 
   Config config_{};
   ParamVector p_ = ParamVector::Zero();
@@ -249,6 +254,9 @@ class PumpDriftEstimator {
   Vec4 seg_sum_{Vec4::Zero()};
   int seg_blocks_{0};
   double w_last_{0};
+  // refresh_fit(): kappa_2 of m_'s 3x3 and the coefficients (zero until valid).
+  double kappa_2_{std::numeric_limits<double>::infinity()};
+  Eigen::Vector3d coefficients_{Eigen::Vector3d::Zero()};
 };
 
 }  // namespace hrg::est

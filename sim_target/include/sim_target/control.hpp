@@ -136,7 +136,23 @@ class SimTarget {
   void run_resonator(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   uint32_t quantize(std::size_t n, hal::q31_t* out);
-  Drive next_drive();
+  // Resonator, noise and ADC in one loop (no burst on); returns the clipped count.
+  uint32_t run_fused(std::size_t n, double dt, hal::q31_t* out);
+  // One ADC conversion with the channel's faults; 1 when it clipped.
+  uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {
+    bool clip = false;
+    hal::q31_t word = adc_q_.convert(v, clip);
+    if (adc_saturated_[ch]) word = adc_q_.convert(1e300, clip);
+    if (adc_stuck_[ch]) {
+      word = adc_last_[ch];
+      clip = false;
+    }
+    adc_last_[ch] = word;
+    out = word;
+    return clip ? 1u : 0u;
+  }
+  // drives_[0..m): the DAC's next m frames through its latency line and quantisers.
+  void fill_drives(std::size_t m);
   uint64_t sample_time_ns(uint64_t index) const;
 
   SimConfig config_;

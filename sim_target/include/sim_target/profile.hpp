@@ -134,6 +134,11 @@ class ProfileCursor {
     if (t_s >= lo_s_ && t_s < hi_s_) return p_->value_in_segment(t_s, segment_);
     return value_searched(t_s, next_step, step_s);
   }
+  // True when value() is one and the same number at every instant of
+  // [t0_s, t1_s] (t0_s <= t1_s): a constant, a step's hold, a ramp's flat
+  // segment; that number goes to `value`. False for a sine (whose cursor
+  // state this leaves untouched) and for a span that crosses a breakpoint.
+  bool constant_over(double t0_s, double t1_s, double& value);
 
  private:
   double value_searched(double t_s, bool next_step, double step_s);

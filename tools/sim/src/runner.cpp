@@ -166,20 +166,28 @@ class RowStamper {
     off_blocks_ = drive_free_blocks_;
   }
 
-  void after_block(const fw::app::Firmware& firmware, const sim::SimTarget& target) {
+  // `stamped`: a row will read this block's state (it lands at kCentre or
+  // kCentre + 1 blocks back at a row); the others skip the true state and
+  // the reference phase, which cost more than the rest of the job loop.
+  void after_block(const fw::app::Firmware& firmware, const sim::SimTarget& target, bool stamped) {
     const fw::GyroStatus& st = firmware.gyro().status();
     off_blocks_ = st.excitation_on ? 0 : off_blocks_ + 1;
-    // NCO phase at the first sample after this block (time t_s) against the
-    // fixed reference 2 pi f_ref t.
-    const double nco_cycles = static_cast<double>(firmware.chain().chain().nco_phase()) * 0x1p-32;
-    const double ref_cycles = std::fmod(f_ref_hz_ * st.chain.t_s, 1.0);
     for (std::size_t i = kHistory - 1; i > 0; --i) {
       ref_offset_[i] = ref_offset_[i - 1];
       truth_[i] = truth_[i - 1];
     }
+    ++blocks_;
+    if (!stamped) return;
+    // NCO phase at the first sample after this block (time t_s) against the
+    // fixed reference 2 pi f_ref t.
+    const double nco_cycles = static_cast<double>(firmware.chain().chain().nco_phase()) * 0x1p-32;
+    const double ref_cycles = std::fmod(f_ref_hz_ * st.chain.t_s, 1.0);
     ref_offset_[0] = 2.0 * kPi * std::remainder(nco_cycles - ref_cycles, 1.0);
     truth_[0] = target.true_state();
-    ++blocks_;
+  }
+  // Whether frame k's block is read by a row taken every row_every frames.
+  static bool stamped(uint64_t k, uint64_t row_every) {
+    return (k + kCentre) % row_every == 0 || (k + kCentre + 1) % row_every == 0;
   }
 
   // Rows start once the history is full.
@@ -350,7 +358,7 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
     const fw::GyroStatus& st = gyro.status();
-    stamp.after_block(*firmware, target);
+    stamp.after_block(*firmware, target, RowStamper::stamped(k, row_every));
     track_events(gyro, target, last_mode, r);
     drain_can(target, log.get(), st.chain.t_s, r);
     if (log && stamp.history_full() && k % lab.period_frames == 0) {

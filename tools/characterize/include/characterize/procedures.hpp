@@ -23,6 +23,9 @@ struct ProcedureOptions {
   std::string scenario;    // TOML scenario (empty: the default gyro of `hrg sim`)
   bool short_run = false;  // shortened records (the CTest): the same steps, less time each
   int turn_ons = 3;        // bias repeatability: turn-ons with different noise seeds
+  // Independent runs (the turn-ons) this many at a time, 0: every core. The
+  // results are the same for every value.
+  unsigned jobs = 0;
   bool progress = false;
 };
 
@@ -62,6 +65,8 @@ struct DriftResult {
 // The parked-angle test alone (the limits procedure needs its 4 theta fit).
 DriftResult run_angle_dependent_bias(const ProcedureOptions& o);
 DriftResult run_drift(const ProcedureOptions& o);
+// The bias over o.turn_ons turn-ons alone (turn_on_bias_dph, repeatability).
+DriftResult run_bias_repeatability(const ProcedureOptions& o);
 
 // --- input rate limits and rate threshold (IEEE 1431 12.10), run-down (12.14) ---
 struct ThresholdStep {

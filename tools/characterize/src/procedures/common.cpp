@@ -45,11 +45,15 @@ simtools::JobConfig scheduled_job(const ProcedureBase& base, const Schedule& sch
   return job;
 }
 
-simtools::JobResult run(const simtools::JobConfig& job, const ProcedureOptions& o, double& wall_s,
-                        double& sim_s) {
+simtools::JobResult run_alone(const simtools::JobConfig& job, const ProcedureOptions& o) {
   simtools::RunOptions opt;
   opt.progress = o.progress;
-  simtools::JobResult r = simtools::run_job(job, opt);
+  return simtools::run_job(job, opt);
+}
+
+simtools::JobResult run(const simtools::JobConfig& job, const ProcedureOptions& o, double& wall_s,
+                        double& sim_s) {
+  simtools::JobResult r = run_alone(job, o);
   wall_s += r.wall_s;
   sim_s += r.sim_s;
   return r;

@@ -35,7 +35,9 @@ struct Schedule {
 // no parks, running to the end of the schedule.
 simtools::JobConfig scheduled_job(const ProcedureBase& base, const Schedule& schedule);
 
-// Runs the job (firmware + simulated target in lockstep) and adds its time.
+// Runs the job (firmware + simulated target in lockstep); run() adds its time.
+// Each run has a simulated target of its own: runs may go on in parallel.
+simtools::JobResult run_alone(const simtools::JobConfig& job, const ProcedureOptions& o);
 simtools::JobResult run(const simtools::JobConfig& job, const ProcedureOptions& o, double& wall_s,
                         double& sim_s);
 

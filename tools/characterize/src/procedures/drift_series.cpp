@@ -4,6 +4,7 @@
 // different noise seeds, and the bias along a temperature ramp.
 #include <cmath>
 
+#include "batch/batch.hpp"
 #include "common.hpp"
 #include "sim_tools/scenario_job.hpp"
 
@@ -20,17 +21,31 @@ double bias_dph(const std::vector<simtools::TelemetryRow>& rows,
   return proc::rate_of(rows, error, t0_s, t1_s) * 3600.0;
 }
 
+// The turn-ons differ by their noise seed alone and share nothing: they run
+// o.jobs at a time and are read in turn-on order.
 void turn_ons(const ProcedureOptions& o, const ProcedureBase& base, DriftResult& res) {
   const double hold_s = o.short_run ? 30.0 : 60.0;
-  for (int i = 0; i < o.turn_ons; ++i) {
+  const auto n = static_cast<std::size_t>(o.turn_ons);
+  std::vector<simtools::JobConfig> jobs;
+  double t0 = 0.0, t1 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
     ProcedureBase b = base;
-    b.job.sim.seed = base.job.sim.seed + 1 + static_cast<uint64_t>(i);
+    b.job.sim.seed = base.job.sim.seed + 1 + i;
     proc::Schedule sch(b.job.firmware.gyro.angular_gain);
-    const double t0 = sch.t() + kSettleS;
+    t0 = sch.t() + kSettleS;
     sch.hold(kSettleS + hold_s);
-    const simtools::JobResult r = proc::run(proc::scheduled_job(b, sch), o, res.wall_s, res.sim_s);
+    t1 = sch.t();
+    jobs.push_back(proc::scheduled_job(b, sch));
+  }
+  ProcedureOptions one = o;
+  one.progress = o.progress && (o.jobs == 1 || n <= 1);  // one bar at a time
+  const std::vector<simtools::JobResult> runs =
+      batch::run_indexed(n, o.jobs, [&](std::size_t i) { return proc::run_alone(jobs[i], one); });
+  for (const simtools::JobResult& r : runs) {
+    res.wall_s += r.wall_s;
+    res.sim_s += r.sim_s;
     res.turn_on_bias_dph.push_back(
-        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, t0, sch.t()));
+        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, t0, t1));
   }
   res.repeatability = bias_repeatability(res.turn_on_bias_dph);
 }
@@ -87,6 +102,12 @@ DriftResult run_angle_dependent_bias(const ProcedureOptions& o) {
   const simtools::TelemetryRow& b = proc::row_at(r.rows, job.sweep_end_s);
   res.theta_at_sweep_end_deg = b.theta_deg;
   res.pattern_per_case = (b.theta_deg - a.theta_deg) / (b.true_angle_deg - a.true_angle_deg);
+  return res;
+}
+
+DriftResult run_bias_repeatability(const ProcedureOptions& o) {
+  DriftResult res;
+  turn_ons(o, procedure_base(o), res);
   return res;
 }
 
