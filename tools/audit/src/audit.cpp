@@ -16,6 +16,7 @@
 #include "dsp/wave_variables.hpp"
 #include "fit.hpp"
 #include "model.hpp"
+#include "noise_model.hpp"
 #include "report_parts.hpp"
 #include "selection.hpp"
 
@@ -50,6 +51,7 @@ struct State {
   FitResult fit;
   std::vector<double> res;
   double kappa = 1.0;
+  ArNoise ar;  // AR noise model of the residuals (tests against this state)
   bool feedthrough = false;
 };
 
@@ -68,6 +70,7 @@ struct Chosen {
   // the baseline's misfit it removes given everything else (-1: edges).
   double value = 0.0, sigma = 0.0, fraction = 0.0;
   bool unique_checked = false;  // fraction from a drop-one refit
+  double unique_dchi = -1.0;    // chi^2 (whitened) it removes given everything else
 };
 
 // One candidate added to the current model.
@@ -92,10 +95,17 @@ class Auditor {
   double ln_neff(const State& s) const {
     return std::log(std::max(10.0, s.kappa * static_cast<double>(s.fit.n_res)));
   }
+  // chi^2 that `next` removes from `cur`: with AR whitening both residuals
+  // are whitened by the noise model of `next` (the model under test: with the
+  // structure it explains taken out, what is left is the noise), otherwise
+  // counted at the smaller effective sample fraction.
+  double delta_chi2(const State& cur, const State& next) const {
+    if (opt_.ar_whitening)
+      return whitened_chi2(d_, cur.res, next.ar) - whitened_chi2(d_, next.res, next.ar);
+    return std::min(cur.kappa, next.kappa) * (cur.fit.chi2 - next.fit.chi2);
+  }
   double delta_bic(const State& cur, const State& next, int extra) const {
-    const double kappa = std::min(cur.kappa, next.kappa);
-    double dchi = kappa * (cur.fit.chi2 - next.fit.chi2);
-    return dchi - extra * ln_neff(next);
+    return delta_chi2(cur, next) - extra * ln_neff(next);
   }
   double heldout_rms(const Mask& mask, const Params& start);
   double rms_v(const State& s) const;
@@ -115,7 +125,9 @@ class Auditor {
   void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
                         AuditResult& out);
   State describe(const State& cat, AuditResult& out);
+  void finish_description(const State& cur, double heldout_after, AuditResult& out);
   State drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out);
+  State test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out);
   void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                       bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
@@ -128,6 +140,7 @@ class Auditor {
   EvalOptions eo_;
   std::size_t n_blocks_fit_ = 0;
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
+  std::vector<const GenericTerm*> described_;      // terms of out.description, in order
 };
 
 bool Auditor::testable(Effect e) const {
@@ -149,6 +162,7 @@ State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough
   s.fit = fit(d_, start, mask, eo_, max_iterations);
   evaluate(d_, s.fit.p, eo_, s.res);
   s.kappa = effective_fraction(s.res, static_cast<std::size_t>(n_free_res()));
+  if (opt_.ar_whitening) s.ar = fit_ar_noise(d_, s.res);
   return s;
 }
 
@@ -521,18 +535,79 @@ State Auditor::describe(const State& cat, AuditResult& out) {
     cur = std::move(next);
   }
   if (taken.empty()) return cat;
+  described_ = taken;
+  out.description.fit_rms_before_v = rms_v(cat);
+  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
+  finish_description(cur, heldout_cur, out);
+  return cur;
+}
+
+// The description's words and numbers from the model `cur` that holds it.
+void Auditor::finish_description(const State& cur, double heldout_after, AuditResult& out) {
   Params sigma{};
   for (int i = 0; i < kParamCount; ++i) {
     const auto k = static_cast<std::size_t>(i);
     sigma[k] = cur.fit.sigma[k] / std::sqrt(cur.kappa);
   }
-  for (std::size_t i = 0; i < taken.size(); ++i)
-    out.description.terms[i].text = describe_term(*taken[i], d_, cur.fit.p, sigma);
-  out.description.fit_rms_before_v = rms_v(cat);
+  for (std::size_t i = 0; i < described_.size(); ++i)
+    out.description.terms[i].text = describe_term(*described_[i], d_, cur.fit.p, sigma);
   out.description.fit_rms_after_v = rms_v(cur);
-  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
-  out.description.heldout_rms_after_v = heldout_cur;
-  return cur;
+  out.description.heldout_rms_after_v = heldout_after;
+}
+
+// A catalogue effect is a constant of the gyro: a pickoff gain or phase
+// mismatch that changes in time (or with the temperature) over the
+// recording is not one, and a calibration with its mean would not hold.
+// Each accepted pickoff effect is tested against its own parameter varying
+// in time and with the temperature (the generic terms that say so, on top
+// of everything accepted); when that variation earns the description's
+// evidence, the effect is no finding and the variation joins the
+// description.
+State Auditor::test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out) {
+  static constexpr struct {
+    Effect e;
+    const char* term;
+  } kVarying[] = {{Effect::pickoff_gain_mismatch, "gain_ratio_drift"},
+                  {Effect::pickoff_gain_mismatch, "gain_ratio_vs_temperature"},
+                  {Effect::pickoff_phase_mismatch, "phase_drift"}};
+  bool changed = false;
+  for (const auto& v : kVarying) {
+    const auto it = std::find_if(chosen.begin(), chosen.end(),
+                                 [&](const Chosen& c) { return c.effect == v.e; });
+    if (it == chosen.end()) continue;
+    const GenericTerm* t = nullptr;
+    for (const auto& g : generic_terms())
+      if (std::string_view(g.id) == v.term) t = &g;
+    if (t == nullptr || full.mask[static_cast<std::size_t>(t->param_ids[0])]) continue;
+    if (t->needs_temp && !(d_.has_temp && d_.temp_span_c > 0.02)) continue;
+    State s = fit_state(with_term(full.mask, *t), full.fit.p, full.feedthrough);
+    const double dbic = delta_bic(full, s, t->n_params);
+    if (dbic < opt_.min_description_bic) continue;
+    // Material: the change over the recording is at least a fifth of the
+    // constant (a tiny trend under a large mismatch leaves the constant good).
+    const auto pc = static_cast<std::size_t>(param_of(v.e));
+    const auto pv = static_cast<std::size_t>(t->param_ids[0]);
+    const double span = t->needs_temp
+                            ? d_.temp_span_c
+                            : (d_.t_s.empty() ? 0.0 : (d_.t_s.back() - d_.t_s.front()) / 3600.0);
+    if (std::abs(s.fit.p[pv]) * span < 0.2 * std::abs(full.fit.p[pc])) continue;
+    if (described_.empty()) {
+      out.description.fit_rms_before_v = rms_v(full);
+      out.description.heldout_rms_before_v = heldout_rms(full.mask, full.fit.p);
+    }
+    const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+    out.description.terms.push_back({t->id, "", dbic, (full.fit.chi2 - s.fit.chi2) / excess0});
+    described_.push_back(t);
+    out.alternatives.push_back(
+        {it->effect, to_catalogue(it->effect, s.fit.p[pc]), it->dbic,
+         std::string("not a constant: its parameter changes (") + t->id +
+             "), so a constant calibration would not hold; described instead"});
+    chosen.erase(it);
+    full = std::move(s);
+    changed = true;
+  }
+  if (changed) finish_description(full, heldout_rms(full.mask, full.fit.p), out);
+  return full;
 }
 
 // Backward elimination over the chosen catalogue effects: each is refitted
@@ -542,7 +617,7 @@ State Auditor::describe(const State& cat, AuditResult& out) {
 // is refitted without it, until every remaining one is needed. One at a time,
 // so that two effects that can stand for each other do not both leave.
 State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out) {
-  if (chosen.size() < 2 && out.description.terms.empty()) return full;
+  if (!opt_.ar_whitening && chosen.size() < 2 && out.description.terms.empty()) return full;
   const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
   for (;;) {
     std::size_t worst = chosen.size();
@@ -558,6 +633,7 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
       q[i] = 0.0;
       State without = fit_state(m, q, false);
       const double unique_dbic = delta_bic(without, full, 1);
+      chosen[k].unique_dchi = delta_chi2(without, full);
       chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
       chosen[k].unique_checked = true;
       if (unique_dbic < worst_dbic)
@@ -589,7 +665,14 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
     if (pi >= 0) {
       const auto i = static_cast<std::size_t>(pi);
       value = to_catalogue(c.effect, full.fit.p[i]);
-      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i])) / std::sqrt(full.kappa);
+      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i]));
+      if (!opt_.ar_whitening) {
+        sigma /= std::sqrt(full.kappa);
+      } else if (c.unique_dchi >= 0.0) {
+        // The likelihood-ratio sigma under the whitened noise: |value| over
+        // the square root of the chi^2 the effect removes given the rest.
+        sigma = std::max(sigma, std::abs(value) / std::sqrt(std::max(c.unique_dchi, 1e-12)));
+      }
       if (!c.unique_checked) c.fraction = std::max(0.0, c.dchi) / excess0;
     } else {
       c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
@@ -688,6 +771,7 @@ AuditResult Auditor::run(PlotData* plot) {
   baseline_n_ = static_cast<double>(baseline.fit.n_res);
   State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
   full = drop_unneeded(std::move(full), chosen, out);
+  full = test_constancy(std::move(full), chosen, out);
   // Structure is left when the description found some, or when the residual
   // stays above the noise including its slow (coloured) part.
   const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));

@@ -62,6 +62,10 @@ struct AuditOptions {
   // smaller structure is not described (it stays in the locations).
   double min_description_share = 0.1;
   int max_description_terms = 3;
+  // Noise model of the tests: residuals whitened by an AR model per channel
+  // (true) or white residuals counted at the effective sample count from
+  // their integrated autocorrelation (false).
+  bool ar_whitening = true;
 };
 
 struct Location {
