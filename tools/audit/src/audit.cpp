@@ -109,6 +109,7 @@ class Auditor {
   }
   double heldout_rms(const Mask& mask, const Params& start);
   double rms_v(const State& s) const;
+  double free_chi2(const State& s) const;  // chi^2 of the free-decay samples alone
   double slow_noise_factor(const State& s) const;
 
   // Steps of run(), in order.
@@ -140,6 +141,7 @@ class Auditor {
   EvalOptions eo_;
   std::size_t n_blocks_fit_ = 0;
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
+  double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
 };
 
@@ -182,12 +184,16 @@ double Auditor::heldout_rms(const Mask& mask, const Params& start) {
   return std::sqrt(s / static_cast<double>(r.size())) * d_.noise_v;
 }
 
-double Auditor::rms_v(const State& s) const {
+double Auditor::free_chi2(const State& s) const {
   double acc = 0.0;
   const auto n = static_cast<std::size_t>(n_free_res());
   for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
     acc += s.res[i] * s.res[i];
-  return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
+  return acc;
+}
+
+double Auditor::rms_v(const State& s) const {
+  return std::sqrt(free_chi2(s) / std::max(1.0, n_free_res())) * d_.noise_v;
 }
 
 // Variance of the block residuals at long lags over the white level: half
@@ -496,15 +502,20 @@ void Auditor::report_baseline(const State& baseline, const State& cur, bool any_
 // only when it also reproduces on the held-out segments (their mean-square
 // residual falls by at least a quarter of what it falls on the fitted ones):
 // slow coloured noise fits a term on the data it sees, not on the rest) and
-// when it is material: it lowers the mean-square residual by at least
-// min_description_share of the noise variance, its slow part included (the
-// slowest octaves of 1/f noise are offsets and drifts over a recording).
-// Returns the model with the description (the catalogue model when nothing
-// is accepted).
+// when it is material: it removes at least min_description_share of the
+// baseline's free-decay misfit beyond the noise (the excitation segments'
+// frequencies follow whatever disturbs their phase, a feedthrough too, and
+// stay with the catalogue's spring; a trace of model error under a large
+// catalogue effect is not worth a description; a weak structure in a
+// recording that is otherwise at the noise is). Its evidence is counted on
+// residuals whitened by the AR noise model, so slow coloured noise does not
+// earn it; noise slower than that model follows must also be outgrown
+// (min_description_fall). Returns the model with the description (the
+// catalogue model when nothing is accepted).
 State Auditor::describe(const State& cat, AuditResult& out) {
   State cur = cat;
   std::vector<const GenericTerm*> taken;
-  const double excess0 = std::max(1.0, cat.fit.chi2 - static_cast<double>(cat.fit.n_res));
+  const double excess0 = std::max(1.0, baseline_free_chi2_ - n_free_res());
   double heldout_cur = -1.0;
   const double slow = slow_noise_factor(cat);
   for (int step = 0; step < opt_.max_description_terms; ++step) {
@@ -528,8 +539,14 @@ State Auditor::describe(const State& cat, AuditResult& out) {
     const double fitted_fall = rms_v(cur) * rms_v(cur) - rms_v(next) * rms_v(next);
     const double heldout_fall = heldout_cur * heldout_cur - heldout_next * heldout_next;
     if (!(heldout_fall > 0.25 * fitted_fall)) break;
-    if (fitted_fall < opt_.min_description_share * slow * d_.noise_v * d_.noise_v) break;
-    out.description.terms.push_back({best->id, "", dbic, (cur.fit.chi2 - next.fit.chi2) / excess0});
+    const double share = (free_chi2(cur) - free_chi2(next)) / excess0;
+    if (share < opt_.min_description_share) break;
+    // Noise slower than the AR model follows (variance at long lags above
+    // the white level): its slowest octaves are offsets and drifts over a
+    // recording, so a term must then also stand above them.
+    if (slow > 1.2 && fitted_fall < opt_.min_description_fall * slow * d_.noise_v * d_.noise_v)
+      break;
+    out.description.terms.push_back({best->id, "", dbic, share});
     taken.push_back(best);
     heldout_cur = heldout_next;
     cur = std::move(next);
@@ -763,13 +780,12 @@ AuditResult Auditor::run(PlotData* plot) {
   // The switching edges against the final free-decay model.
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   test_feedthrough(cur, ft, chosen, out);
-  // The description is looked for when something was chosen (its weight is
-  // then tested against it) or the residual is above the white noise at all;
-  // a recording at the noise has nothing to describe.
-  const double ratio0 = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  // The description is always looked for: a weak structure outside the
+  // catalogue can leave the total misfit at the noise.
   baseline_chi2_ = baseline.fit.chi2;
   baseline_n_ = static_cast<double>(baseline.fit.n_res);
-  State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  baseline_free_chi2_ = free_chi2(baseline);
+  State full = describe(cur, out);
   full = drop_unneeded(std::move(full), chosen, out);
   full = test_constancy(std::move(full), chosen, out);
   // Structure is left when the description found some, or when the residual

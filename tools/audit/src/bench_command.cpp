@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "audit/audit.hpp"
 #include "audit/audit_command.hpp"
@@ -33,8 +35,9 @@ void bench_usage(std::FILE* f) {
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
-               "writes one simulated campaign, optionally with one catalogue effect (a\n"
-               "firmware campaign lasts as long as its table turn; --duration is ignored),\n"
+               "writes one simulated campaign, optionally with catalogue effects (--effect\n"
+               "repeated; a firmware campaign lasts as long as its table turn; --duration is\n"
+               "ignored),\n"
                "1/f noise, one effect outside the catalogue (gain_ratio_drift 1/h,\n"
                "phase_drift rad/h, offset_x V, gain_ratio_vs_temperature 1/degC) and a\n"
                "reference that follows the resonance (f_ref_hz per row).\n");
@@ -75,8 +78,9 @@ double speed_run(double hours, uint64_t seed) {
 struct BenchArgs {
   BenchOptions o;
   double hours = 1.0;
-  std::string emit, design = "ringdown", effect, outside;
-  double duration_s = 480.0, value = 0.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
+  std::string emit, design = "ringdown", outside;
+  std::vector<std::pair<std::string, double>> effects;  // --effect ID VALUE, repeatable
+  double duration_s = 480.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
   bool pll = false;
 };
 
@@ -105,8 +109,8 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
   } else if (a == "--duration" && has_value) {
     b.duration_s = std::atof(args[++i]);
   } else if (a == "--effect" && i + 2 < args.size()) {
-    b.effect = args[++i];
-    b.value = std::atof(args[++i]);
+    const std::string id = args[++i];
+    b.effects.emplace_back(id, std::atof(args[++i]));
   } else if (a == "--flicker" && has_value) {
     b.flicker_hz = std::atof(args[++i]);
   } else if (a == "--outside" && i + 2 < args.size()) {
@@ -134,9 +138,11 @@ int emit_recording(const BenchArgs& b) {
     return 2;
   }
   auto sc = bench::random_scenario(design, b.duration_s, b.o.seed);
-  if (!b.effect.empty() && !bench::conceal_by_id(sc, b.effect, b.value, b.o.seed)) {
-    std::fprintf(stderr, "hrg audit-bench: unknown effect '%s'\n", b.effect.c_str());
-    return 2;
+  for (const auto& [id, value] : b.effects) {
+    if (!bench::conceal_by_id(sc, id, value, b.o.seed)) {
+      std::fprintf(stderr, "hrg audit-bench: unknown effect '%s'\n", id.c_str());
+      return 2;
+    }
   }
   if (b.noise_v >= 0.0) sc.noise_v = b.noise_v;
   sc.flicker_corner_hz = b.flicker_hz;
