@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // A small run of the audit benchmark with its rates asserted (slow).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -26,6 +27,18 @@ TEST(AuditBenchmark, ConcealedEffectsAreFoundAndNullsStayClean) {
   // parameter within 20 %: at least 4 of 5 in this small sample.
   CHECK(r.above2x >= 3);
   CHECK(5 * r.above2x_hits >= 4 * r.above2x);
+  // The cases beyond one effect are counted in the total (every design
+  // gives a 1/f null and one effect outside the catalogue), as many as
+  // their recordings.
+  LONGS_EQUAL(2, r.coloured_nulls);
+  LONGS_EQUAL(2, r.outside);
+  auto count = [&](hrg::audit::CaseKind k) {
+    return static_cast<int>(
+        std::count_if(r.cases.begin(), r.cases.end(), [&](const auto& c) { return c.kind == k; }));
+  };
+  LONGS_EQUAL(count(hrg::audit::CaseKind::pair), r.pairs);
+  LONGS_EQUAL(count(hrg::audit::CaseKind::triple), r.triples);
+  CHECK(r.pairs >= 1 && r.triples >= 1);
 }
 
 namespace {

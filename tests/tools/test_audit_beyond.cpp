@@ -96,6 +96,30 @@ TEST(AuditBeyondCatalogue, SlowColouredNoiseIsNotStructure) {
   STRCMP_EQUAL_TEXT("consistent", r.verdict.c_str(), hrg::audit::to_text(r, "1/f").c_str());
 }
 
+TEST(AuditBeyondCatalogue, PairUnderColouredNoiseIsFoundAndNothingElse) {
+  // GIVEN the 1/f null (corner 1.5 Hz) and, on the same campaign and noise,
+  // a pickoff phase mismatch and a thermal frequency at 3x the thresholds
+  // that null reports (thresholds at its own, coloured, noise)
+  bench::Scenario base = ringdown();
+  base.flicker_corner_hz = 1.5;
+  const AuditResult null = hrg::audit::run_audit(bench::simulate(base));
+  STRCMP_EQUAL_TEXT("consistent", null.verdict.c_str(), hrg::audit::to_text(null, "1/f").c_str());
+  const double phase = 3.0 * threshold_of(null, Effect::pickoff_phase_mismatch);
+  const double tf = -3.0 * threshold_of(null, Effect::thermal_frequency);
+  bench::Scenario s = base;
+  CHECK(bench::conceal_by_id(s, "pickoff_phase_mismatch", phase, kSeed));
+  CHECK(bench::conceal_by_id(s, "thermal_frequency", tf, kSeed));
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "pair under 1/f");
+  // THEN exactly these two are the findings, each within 20 %
+  LONGS_EQUAL_TEXT(2, r.findings.size(), text.c_str());
+  const auto* p = finding_of(r, Effect::pickoff_phase_mismatch);
+  const auto* t = finding_of(r, Effect::thermal_frequency);
+  CHECK_TEXT(p != nullptr && t != nullptr, text.c_str());
+  DOUBLES_EQUAL(phase, p->value, 0.2 * std::abs(phase));
+  DOUBLES_EQUAL(tf, t->value, 0.2 * std::abs(tf));
+}
+
 TEST(AuditBeyondCatalogue, ReferenceFollowingTheResonanceIsRead) {
   // GIVEN the envelopes against a reference that pulls in to the resonance
   // and wanders by mHz around it (f_ref_hz per row)

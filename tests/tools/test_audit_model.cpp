@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "audit/audit.hpp"
 #include "audit/audit_command.hpp"
 #include "../../tools/audit/src/model.hpp"
+#include "../../tools/audit/src/noise_model.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -102,4 +104,49 @@ TEST(AuditInput, RecordingWithoutFreeDecayIsRefused) {
 TEST(AuditInput, UsageErrorsReturnTwo) {
   LONGS_EQUAL(2, run_audit_cli({}));
   LONGS_EQUAL(2, run_audit_cli({"a.csv", "--bogus"}));
+}
+
+TEST_GROUP(AuditNoiseModel){};
+
+TEST(AuditNoiseModel, ArModelWhitensAnAr1ResidualAndLeavesWhiteNoiseAlone) {
+  // GIVEN residuals of 20 free segments of 400 blocks (4 channels per block):
+  // channel 0 an AR(1) process r_t = 0.9 r_{t-1} + e_t with var(e) = 0.25,
+  // the other channels white with unit variance
+  hrg::audit::detail::Dataset d;
+  std::mt19937_64 g(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<double> res;
+  for (int s = 0; s < 20; ++s) {
+    hrg::audit::detail::FreeSegment seg;
+    seg.first_block = static_cast<std::size_t>(s) * 400;
+    seg.n_blocks = 400;
+    d.free.push_back(seg);
+    double ar = n(g) * 0.5 / std::sqrt(1.0 - 0.81);  // stationary start
+    for (int b = 0; b < 400; ++b) {
+      ar = 0.9 * ar + 0.5 * n(g);
+      res.push_back(ar);
+      for (int c = 1; c < 4; ++c)
+        res.push_back(n(g));
+    }
+  }
+  // WHEN the AR noise model is fitted
+  const auto m = hrg::audit::detail::fit_ar_noise(d, res);
+  // THEN channel 0 gets order 1 (BIC) with a_1 = 0.9 and var(e) = 0.25 to a
+  // few standard errors (sd of a_1 = sqrt((1 - 0.81)/8000) = 0.005), and the
+  // white channels order 0 with unit variance (sd sqrt(2/8000) = 0.016)
+  CHECK_EQUAL(1, m.order(0));
+  DOUBLES_EQUAL(0.9, m.orders[0][1].coef[0], 0.02);
+  DOUBLES_EQUAL(0.25, m.orders[0][1].var, 0.25 * 0.06);
+  for (std::size_t c = 1; c < 4; ++c) {
+    CHECK_EQUAL(0, m.order(c));
+    DOUBLES_EQUAL(1.0, m.orders[c][0].var, 0.06);
+  }
+  // AND the whitened chi^2 is about its count (32000 +- 4 sd of 253), while
+  // the raw one is inflated by the AR channel's variance 0.25/0.19 = 1.32
+  const double chi2_w = hrg::audit::detail::whitened_chi2(d, res, m);
+  DOUBLES_EQUAL(32000.0, chi2_w, 1000.0);
+  double raw = 0.0;
+  for (double v : res)
+    raw += v * v;
+  CHECK(raw > chi2_w + 0.2 * 8000.0);
 }

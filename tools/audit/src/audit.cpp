@@ -16,6 +16,7 @@
 #include "dsp/wave_variables.hpp"
 #include "fit.hpp"
 #include "model.hpp"
+#include "noise_model.hpp"
 #include "report_parts.hpp"
 #include "selection.hpp"
 
@@ -50,6 +51,7 @@ struct State {
   FitResult fit;
   std::vector<double> res;
   double kappa = 1.0;
+  ArNoise ar;  // AR noise model of the residuals (tests against this state)
   bool feedthrough = false;
 };
 
@@ -68,6 +70,7 @@ struct Chosen {
   // the baseline's misfit it removes given everything else (-1: edges).
   double value = 0.0, sigma = 0.0, fraction = 0.0;
   bool unique_checked = false;  // fraction from a drop-one refit
+  double unique_dchi = -1.0;    // chi^2 (whitened) it removes given everything else
 };
 
 // One candidate added to the current model.
@@ -92,13 +95,21 @@ class Auditor {
   double ln_neff(const State& s) const {
     return std::log(std::max(10.0, s.kappa * static_cast<double>(s.fit.n_res)));
   }
+  // chi^2 that `next` removes from `cur`: with AR whitening both residuals
+  // are whitened by the noise model of `next` (the model under test: with the
+  // structure it explains taken out, what is left is the noise), otherwise
+  // counted at the smaller effective sample fraction.
+  double delta_chi2(const State& cur, const State& next) const {
+    if (opt_.ar_whitening)
+      return whitened_chi2(d_, cur.res, next.ar) - whitened_chi2(d_, next.res, next.ar);
+    return std::min(cur.kappa, next.kappa) * (cur.fit.chi2 - next.fit.chi2);
+  }
   double delta_bic(const State& cur, const State& next, int extra) const {
-    const double kappa = std::min(cur.kappa, next.kappa);
-    double dchi = kappa * (cur.fit.chi2 - next.fit.chi2);
-    return dchi - extra * ln_neff(next);
+    return delta_chi2(cur, next) - extra * ln_neff(next);
   }
   double heldout_rms(const Mask& mask, const Params& start);
   double rms_v(const State& s) const;
+  double free_chi2(const State& s) const;  // chi^2 of the free-decay samples alone
   double slow_noise_factor(const State& s) const;
 
   // Steps of run(), in order.
@@ -115,7 +126,9 @@ class Auditor {
   void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
                         AuditResult& out);
   State describe(const State& cat, AuditResult& out);
+  void finish_description(const State& cur, double heldout_after, AuditResult& out);
   State drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out);
+  State test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out);
   void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                       bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
@@ -128,6 +141,8 @@ class Auditor {
   EvalOptions eo_;
   std::size_t n_blocks_fit_ = 0;
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
+  double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
+  std::vector<const GenericTerm*> described_;      // terms of out.description, in order
 };
 
 bool Auditor::testable(Effect e) const {
@@ -149,6 +164,7 @@ State Auditor::fit_state(const Mask& mask, const Params& start, bool feedthrough
   s.fit = fit(d_, start, mask, eo_, max_iterations);
   evaluate(d_, s.fit.p, eo_, s.res);
   s.kappa = effective_fraction(s.res, static_cast<std::size_t>(n_free_res()));
+  if (opt_.ar_whitening) s.ar = fit_ar_noise(d_, s.res);
   return s;
 }
 
@@ -168,12 +184,16 @@ double Auditor::heldout_rms(const Mask& mask, const Params& start) {
   return std::sqrt(s / static_cast<double>(r.size())) * d_.noise_v;
 }
 
-double Auditor::rms_v(const State& s) const {
+double Auditor::free_chi2(const State& s) const {
   double acc = 0.0;
   const auto n = static_cast<std::size_t>(n_free_res());
   for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
     acc += s.res[i] * s.res[i];
-  return std::sqrt(acc / std::max(1.0, n_free_res())) * d_.noise_v;
+  return acc;
+}
+
+double Auditor::rms_v(const State& s) const {
+  return std::sqrt(free_chi2(s) / std::max(1.0, n_free_res())) * d_.noise_v;
 }
 
 // Variance of the block residuals at long lags over the white level: half
@@ -482,15 +502,20 @@ void Auditor::report_baseline(const State& baseline, const State& cur, bool any_
 // only when it also reproduces on the held-out segments (their mean-square
 // residual falls by at least a quarter of what it falls on the fitted ones):
 // slow coloured noise fits a term on the data it sees, not on the rest) and
-// when it is material: it lowers the mean-square residual by at least
-// min_description_share of the noise variance, its slow part included (the
-// slowest octaves of 1/f noise are offsets and drifts over a recording).
-// Returns the model with the description (the catalogue model when nothing
-// is accepted).
+// when it is material: it removes at least min_description_share of the
+// baseline's free-decay misfit beyond the noise (the excitation segments'
+// frequencies follow whatever disturbs their phase, a feedthrough too, and
+// stay with the catalogue's spring; a trace of model error under a large
+// catalogue effect is not worth a description; a weak structure in a
+// recording that is otherwise at the noise is). Its evidence is counted on
+// residuals whitened by the AR noise model, so slow coloured noise does not
+// earn it; noise slower than that model follows must also be outgrown
+// (min_description_fall). Returns the model with the description (the
+// catalogue model when nothing is accepted).
 State Auditor::describe(const State& cat, AuditResult& out) {
   State cur = cat;
   std::vector<const GenericTerm*> taken;
-  const double excess0 = std::max(1.0, cat.fit.chi2 - static_cast<double>(cat.fit.n_res));
+  const double excess0 = std::max(1.0, baseline_free_chi2_ - n_free_res());
   double heldout_cur = -1.0;
   const double slow = slow_noise_factor(cat);
   for (int step = 0; step < opt_.max_description_terms; ++step) {
@@ -514,25 +539,92 @@ State Auditor::describe(const State& cat, AuditResult& out) {
     const double fitted_fall = rms_v(cur) * rms_v(cur) - rms_v(next) * rms_v(next);
     const double heldout_fall = heldout_cur * heldout_cur - heldout_next * heldout_next;
     if (!(heldout_fall > 0.25 * fitted_fall)) break;
-    if (fitted_fall < opt_.min_description_share * slow * d_.noise_v * d_.noise_v) break;
-    out.description.terms.push_back({best->id, "", dbic, (cur.fit.chi2 - next.fit.chi2) / excess0});
+    const double share = (free_chi2(cur) - free_chi2(next)) / excess0;
+    if (share < opt_.min_description_share) break;
+    // Noise slower than the AR model follows (variance at long lags above
+    // the white level): its slowest octaves are offsets and drifts over a
+    // recording, so a term must then also stand above them.
+    if (slow > 1.2 && fitted_fall < opt_.min_description_fall * slow * d_.noise_v * d_.noise_v)
+      break;
+    out.description.terms.push_back({best->id, "", dbic, share});
     taken.push_back(best);
     heldout_cur = heldout_next;
     cur = std::move(next);
   }
   if (taken.empty()) return cat;
+  described_ = taken;
+  out.description.fit_rms_before_v = rms_v(cat);
+  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
+  finish_description(cur, heldout_cur, out);
+  return cur;
+}
+
+// The description's words and numbers from the model `cur` that holds it.
+void Auditor::finish_description(const State& cur, double heldout_after, AuditResult& out) {
   Params sigma{};
   for (int i = 0; i < kParamCount; ++i) {
     const auto k = static_cast<std::size_t>(i);
     sigma[k] = cur.fit.sigma[k] / std::sqrt(cur.kappa);
   }
-  for (std::size_t i = 0; i < taken.size(); ++i)
-    out.description.terms[i].text = describe_term(*taken[i], d_, cur.fit.p, sigma);
-  out.description.fit_rms_before_v = rms_v(cat);
+  for (std::size_t i = 0; i < described_.size(); ++i)
+    out.description.terms[i].text = describe_term(*described_[i], d_, cur.fit.p, sigma);
   out.description.fit_rms_after_v = rms_v(cur);
-  out.description.heldout_rms_before_v = heldout_rms(cat.mask, cat.fit.p);
-  out.description.heldout_rms_after_v = heldout_cur;
-  return cur;
+  out.description.heldout_rms_after_v = heldout_after;
+}
+
+// A catalogue effect is a constant of the gyro: a pickoff gain or phase
+// mismatch that changes in time (or with the temperature) over the
+// recording is not one, and a calibration with its mean would not hold.
+// Each accepted pickoff effect is tested against its own parameter varying
+// in time and with the temperature (the generic terms that say so, on top
+// of everything accepted); when that variation earns the description's
+// evidence, the effect is no finding and the variation joins the
+// description.
+State Auditor::test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out) {
+  static constexpr struct {
+    Effect e;
+    const char* term;
+  } kVarying[] = {{Effect::pickoff_gain_mismatch, "gain_ratio_drift"},
+                  {Effect::pickoff_gain_mismatch, "gain_ratio_vs_temperature"},
+                  {Effect::pickoff_phase_mismatch, "phase_drift"}};
+  bool changed = false;
+  for (const auto& v : kVarying) {
+    const auto it = std::find_if(chosen.begin(), chosen.end(),
+                                 [&](const Chosen& c) { return c.effect == v.e; });
+    if (it == chosen.end()) continue;
+    const GenericTerm* t = nullptr;
+    for (const auto& g : generic_terms())
+      if (std::string_view(g.id) == v.term) t = &g;
+    if (t == nullptr || full.mask[static_cast<std::size_t>(t->param_ids[0])]) continue;
+    if (t->needs_temp && !(d_.has_temp && d_.temp_span_c > 0.02)) continue;
+    State s = fit_state(with_term(full.mask, *t), full.fit.p, full.feedthrough);
+    const double dbic = delta_bic(full, s, t->n_params);
+    if (dbic < opt_.min_description_bic) continue;
+    // Material: the change over the recording is at least a fifth of the
+    // constant (a tiny trend under a large mismatch leaves the constant good).
+    const auto pc = static_cast<std::size_t>(param_of(v.e));
+    const auto pv = static_cast<std::size_t>(t->param_ids[0]);
+    const double span = t->needs_temp
+                            ? d_.temp_span_c
+                            : (d_.t_s.empty() ? 0.0 : (d_.t_s.back() - d_.t_s.front()) / 3600.0);
+    if (std::abs(s.fit.p[pv]) * span < 0.2 * std::abs(full.fit.p[pc])) continue;
+    if (described_.empty()) {
+      out.description.fit_rms_before_v = rms_v(full);
+      out.description.heldout_rms_before_v = heldout_rms(full.mask, full.fit.p);
+    }
+    const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+    out.description.terms.push_back({t->id, "", dbic, (full.fit.chi2 - s.fit.chi2) / excess0});
+    described_.push_back(t);
+    out.alternatives.push_back(
+        {it->effect, to_catalogue(it->effect, s.fit.p[pc]), it->dbic,
+         std::string("not a constant: its parameter changes (") + t->id +
+             "), so a constant calibration would not hold; described instead"});
+    chosen.erase(it);
+    full = std::move(s);
+    changed = true;
+  }
+  if (changed) finish_description(full, heldout_rms(full.mask, full.fit.p), out);
+  return full;
 }
 
 // Backward elimination over the chosen catalogue effects: each is refitted
@@ -542,7 +634,7 @@ State Auditor::describe(const State& cat, AuditResult& out) {
 // is refitted without it, until every remaining one is needed. One at a time,
 // so that two effects that can stand for each other do not both leave.
 State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out) {
-  if (chosen.size() < 2 && out.description.terms.empty()) return full;
+  if (!opt_.ar_whitening && chosen.size() < 2 && out.description.terms.empty()) return full;
   const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
   for (;;) {
     std::size_t worst = chosen.size();
@@ -558,6 +650,7 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
       q[i] = 0.0;
       State without = fit_state(m, q, false);
       const double unique_dbic = delta_bic(without, full, 1);
+      chosen[k].unique_dchi = delta_chi2(without, full);
       chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
       chosen[k].unique_checked = true;
       if (unique_dbic < worst_dbic)
@@ -589,7 +682,14 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
     if (pi >= 0) {
       const auto i = static_cast<std::size_t>(pi);
       value = to_catalogue(c.effect, full.fit.p[i]);
-      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i])) / std::sqrt(full.kappa);
+      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i]));
+      if (!opt_.ar_whitening) {
+        sigma /= std::sqrt(full.kappa);
+      } else if (c.unique_dchi >= 0.0) {
+        // The likelihood-ratio sigma under the whitened noise: |value| over
+        // the square root of the chi^2 the effect removes given the rest.
+        sigma = std::max(sigma, std::abs(value) / std::sqrt(std::max(c.unique_dchi, 1e-12)));
+      }
       if (!c.unique_checked) c.fraction = std::max(0.0, c.dchi) / excess0;
     } else {
       c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
@@ -680,14 +780,14 @@ AuditResult Auditor::run(PlotData* plot) {
   // The switching edges against the final free-decay model.
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   test_feedthrough(cur, ft, chosen, out);
-  // The description is looked for when something was chosen (its weight is
-  // then tested against it) or the residual is above the white noise at all;
-  // a recording at the noise has nothing to describe.
-  const double ratio0 = cur.fit.chi2 / std::max(1.0, static_cast<double>(cur.fit.n_res));
+  // The description is always looked for: a weak structure outside the
+  // catalogue can leave the total misfit at the noise.
   baseline_chi2_ = baseline.fit.chi2;
   baseline_n_ = static_cast<double>(baseline.fit.n_res);
-  State full = !chosen.empty() || ratio0 > 1.02 ? describe(cur, out) : cur;
+  baseline_free_chi2_ = free_chi2(baseline);
+  State full = describe(cur, out);
   full = drop_unneeded(std::move(full), chosen, out);
+  full = test_constancy(std::move(full), chosen, out);
   // Structure is left when the description found some, or when the residual
   // stays above the noise including its slow (coloured) part.
   const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));

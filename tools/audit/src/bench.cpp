@@ -277,95 +277,132 @@ struct DesignPart {
   std::string log;  // the --verbose lines, printed in design order
 };
 
+// The null twin of a design: the same resonator, campaign and noise with
+// nothing concealed. Its audit gives the thresholds the effects are set by.
+AuditResult run_null(const Scenario& base, int d, const AuditFn& audit, DesignPart& part,
+                     bool verbose) {
+  auto [null_r, null_s] = audit(bench::simulate(base));
+  BenchResult& res = part.res;
+  BenchCase nc;
+  nc.kind = CaseKind::null_white;
+  nc.pll_reference = base.pll_reference;
+  nc.design = d;
+  nc.campaign = base.design;
+  nc.top = top_of(null_r, nc.top_value);
+  nc.verdict = null_r.verdict;
+  nc.seconds = null_s;
+  res.cases.push_back(nc);
+  ++res.nulls;
+  if (nc.top >= 0) ++res.null_findings;
+  if (null_r.verdict == "unexplained") ++res.null_unexplained;
+  res.confusion[kEffectCount][nc.top >= 0 ? static_cast<std::size_t>(nc.top) : kEffectCount]++;
+  if (verbose) {
+    part.log += fmt_line("design %d (%s) null: %s\n", d, bench::design_name(base.design),
+                         null_r.verdict.c_str());
+  }
+  return std::move(null_r);
+}
+
+// One catalogue effect concealed at 0.3x-3x its threshold `cand` (read from
+// the null twin), audited and counted.
+void run_single(const Scenario& base, const CandidateScore& cand, int d, std::mt19937_64& g,
+                const AuditFn& audit, DesignPart& part, bool verbose) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  BenchResult& res = part.res;
+  BenchCase c;
+  c.pll_reference = base.pll_reference;
+  c.design = d;
+  c.campaign = base.design;
+  c.truth = static_cast<int>(cand.effect);
+  c.strength = 0.3 + 2.7 * u(g);
+  const double sign = u(g) < 0.5 ? -1.0 : 1.0;
+  c.true_value = sign * c.strength * cand.threshold;
+  if (cand.effect == Effect::drive_feedthrough) c.true_value = std::abs(c.true_value);
+  // Keep the damping physical: it may change by at most half over the
+  // campaign's amplitude or temperature range. A design whose threshold
+  // lies beyond that cannot reveal the effect and is not scored.
+  if (!physical(base, cand.effect, c.true_value)) {
+    ++res.unscored;
+    return;
+  }
+  Scenario s = base;
+  conceal(s, cand.effect, c.true_value, g);
+  const auto [r, secs] = audit(bench::simulate(s));
+  c.top = top_of(r, c.top_value);
+  c.verdict = r.verdict;
+  c.seconds = secs;
+  res.confusion[static_cast<std::size_t>(c.truth)]
+               [c.top >= 0 ? static_cast<std::size_t>(c.top) : kEffectCount]++;
+  if (c.strength >= 2.0) {
+    ++res.above2x;
+    if (is_hit(c)) ++res.above2x_hits;
+  }
+  if (c.strength < 1.0) {
+    ++res.below1x;
+    if (c.top == c.truth) ++res.below1x_found;
+  }
+  if (verbose) {
+    part.log += fmt_line("  %-24s x%.2f true %.4g -> %s %s %.4g%s\n", effect_info(cand.effect).id,
+                         c.strength, c.true_value, r.verdict.c_str(),
+                         c.top >= 0 ? effect_info(static_cast<Effect>(c.top)).id : "-", c.top_value,
+                         c.strength >= 2.0 && !is_hit(c) ? "   <-- MISS" : "");
+  }
+  res.cases.push_back(c);
+}
+
 DesignPart run_design(const BenchOptions& o, int d) {
   DesignPart part;
-  BenchResult& res = part.res;
-  double& audit_s = part.audit_s;
-  int& audits = part.audits;
-  auto timed_audit = [&](const recording::Recording& rec) {
+  const AuditFn timed_audit = [&part](const recording::Recording& rec) {
     const auto t0 = std::chrono::steady_clock::now();
     AuditResult r = run_audit(rec);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    audit_s += s;
-    ++audits;
-    return std::make_pair(r, s);
+    part.audit_s += s;
+    ++part.audits;
+    return std::make_pair(std::move(r), s);
   };
-  {
-    const Design kind = design_of(o, d);
-    const uint64_t seed = o.seed * 100003ULL + static_cast<uint64_t>(d);
-    Scenario base =
-        bench::random_scenario(kind, kind == Design::ringdown ? o.ringdown_s : o.telemetry_s, seed);
-    // Every other round of the averaged-model designs is demodulated against
-    // a reference that follows the resonance (f_ref_hz per row).
-    base.pll_reference = kind != Design::firmware && (d / 3) % 2 == 1;
-    // Null twin: the same resonator, campaign and noise with nothing concealed.
-    const auto [null_r, null_s] = timed_audit(bench::simulate(base));
-    BenchCase nc;
-    nc.kind = CaseKind::null_white;
-    nc.pll_reference = base.pll_reference;
-    nc.design = d;
-    nc.campaign = kind;
-    nc.top = top_of(null_r, nc.top_value);
-    nc.verdict = null_r.verdict;
-    nc.seconds = null_s;
-    res.cases.push_back(nc);
-    ++res.nulls;
-    if (nc.top >= 0) ++res.null_findings;
-    if (null_r.verdict == "unexplained") ++res.null_unexplained;
-    res.confusion[kEffectCount][nc.top >= 0 ? static_cast<std::size_t>(nc.top) : kEffectCount]++;
-    if (o.verbose) {
-      part.log += fmt_line("design %d (%s) null: %s\n", d, bench::design_name(kind),
-                           null_r.verdict.c_str());
-    }
-    std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    for (const auto& cand : null_r.candidates) {
-      if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
-      BenchCase c;
-      c.pll_reference = base.pll_reference;
-      c.design = d;
-      c.campaign = kind;
-      c.truth = static_cast<int>(cand.effect);
-      c.strength = 0.3 + 2.7 * u(g);
-      const double sign = u(g) < 0.5 ? -1.0 : 1.0;
-      c.true_value = sign * c.strength * cand.threshold;
-      if (cand.effect == Effect::drive_feedthrough) c.true_value = std::abs(c.true_value);
-      // Keep the damping physical: it may change by at most half over the
-      // campaign's amplitude or temperature range. A design whose threshold
-      // lies beyond that cannot reveal the effect and is not scored.
-      if (!physical(base, cand.effect, c.true_value)) {
-        ++res.unscored;
-        continue;
-      }
-      Scenario s = base;
-      conceal(s, cand.effect, c.true_value, g);
-      const auto [r, secs] = timed_audit(bench::simulate(s));
-      c.top = top_of(r, c.top_value);
-      c.verdict = r.verdict;
-      c.seconds = secs;
-      res.confusion[static_cast<std::size_t>(c.truth)]
-                   [c.top >= 0 ? static_cast<std::size_t>(c.top) : kEffectCount]++;
-      if (c.strength >= 2.0) {
-        ++res.above2x;
-        if (is_hit(c)) ++res.above2x_hits;
-      }
-      if (c.strength < 1.0) {
-        ++res.below1x;
-        if (c.top == c.truth) ++res.below1x_found;
-      }
-      if (o.verbose) {
-        part.log +=
-            fmt_line("  %-24s x%.2f true %.4g -> %s %s %.4g%s\n", effect_info(cand.effect).id,
-                     c.strength, c.true_value, r.verdict.c_str(),
-                     c.top >= 0 ? effect_info(static_cast<Effect>(c.top)).id : "-", c.top_value,
-                     c.strength >= 2.0 && !is_hit(c) ? "   <-- MISS" : "");
-      }
-      res.cases.push_back(c);
-    }
-    if (o.extra_cases)
-      run_extra_cases(base, null_r, d, seed, timed_audit, o.verbose ? &part.log : nullptr, res);
+  const Design kind = design_of(o, d);
+  const uint64_t seed = o.seed * 100003ULL + static_cast<uint64_t>(d);
+  Scenario base =
+      bench::random_scenario(kind, kind == Design::ringdown ? o.ringdown_s : o.telemetry_s, seed);
+  // Every other round of the averaged-model designs is demodulated against
+  // a reference that follows the resonance (f_ref_hz per row).
+  base.pll_reference = kind != Design::firmware && (d / 3) % 2 == 1;
+  const AuditResult null_r = run_null(base, d, timed_audit, part, o.verbose);
+  std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
+  for (const auto& cand : null_r.candidates) {
+    if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
+    run_single(base, cand, d, g, timed_audit, part, o.verbose);
   }
+  if (o.extra_cases)
+    run_extra_cases(base, null_r, d, seed, timed_audit, o.verbose ? &part.log : nullptr, part.res);
   return part;
+}
+
+// Adds one design's counts to the total (every counter of BenchResult).
+void add_counts(BenchResult& res, const BenchResult& r) {
+  res.cases.insert(res.cases.end(), r.cases.begin(), r.cases.end());
+  for (std::size_t i = 0; i < res.confusion.size(); ++i)
+    for (std::size_t j = 0; j < res.confusion[i].size(); ++j)
+      res.confusion[i][j] += r.confusion[i][j];
+  res.above2x += r.above2x;
+  res.above2x_hits += r.above2x_hits;
+  res.nulls += r.nulls;
+  res.null_findings += r.null_findings;
+  res.null_unexplained += r.null_unexplained;
+  res.below1x += r.below1x;
+  res.below1x_found += r.below1x_found;
+  res.unscored += r.unscored;
+  res.coloured_nulls += r.coloured_nulls;
+  res.coloured_null_findings += r.coloured_null_findings;
+  res.coloured_null_unexplained += r.coloured_null_unexplained;
+  res.pairs += r.pairs;
+  res.pairs_found += r.pairs_found;
+  res.triples += r.triples;
+  res.triples_found += r.triples_found;
+  res.outside += r.outside;
+  res.outside_described += r.outside_described;
+  res.outside_matched += r.outside_matched;
+  res.outside_catalogue += r.outside_catalogue;
 }
 
 }  // namespace
@@ -381,18 +418,7 @@ BenchResult run_benchmark(const BenchOptions& o) {
   int audits = 0;
   for (const DesignPart& p : parts) {
     if (o.verbose) std::fputs(p.log.c_str(), stderr);
-    const BenchResult& r = p.res;
-    res.cases.insert(res.cases.end(), r.cases.begin(), r.cases.end());
-    for (std::size_t i = 0; i < res.confusion.size(); ++i)
-      for (std::size_t j = 0; j < res.confusion[i].size(); ++j)
-        res.confusion[i][j] += r.confusion[i][j];
-    res.above2x += r.above2x;
-    res.above2x_hits += r.above2x_hits;
-    res.nulls += r.nulls;
-    res.null_findings += r.null_findings;
-    res.below1x += r.below1x;
-    res.below1x_found += r.below1x_found;
-    res.unscored += r.unscored;
+    add_counts(res, p.res);
     audit_s += p.audit_s;
     audits += p.audits;
   }
@@ -452,9 +478,12 @@ std::string format_beyond_catalogue(const BenchResult& r) {
 
 }  // namespace
 
-std::string format_benchmark(const BenchResult& r) {
+namespace {
+
+// The confusion matrix: rows the concealed effect, columns the top finding.
+std::string format_confusion(const BenchResult& r) {
   std::string o;
-  char buf[512];
+  char buf[128];
   static const char* kShort[kEffectCount + 1] = {"gain",   "phase",  "misal",  "duff",   "nldamp",
                                                  "thfreq", "thdamp", "spring", "feedth", "none"};
   o += "Confusion matrix (rows: concealed effect, columns: top finding)\n";
@@ -475,21 +504,21 @@ std::string format_benchmark(const BenchResult& r) {
     }
     o += "\n";
   }
+  return o;
+}
+
+// The headline rates of the one-effect recordings, in total and per design.
+std::string format_rates(const BenchResult& r) {
+  std::string o;
+  char buf[512];
   std::snprintf(buf, sizeof buf,
                 "\nHit rate above 2x threshold (top finding right, parameter within 20 %%): "
-                "%d/%d = %.1f %% (goal >= 95 %%)\n",
-                r.above2x_hits, r.above2x, r.above2x ? 100.0 * r.above2x_hits / r.above2x : 0.0);
-  o += buf;
-  std::snprintf(buf, sizeof buf,
-                "False-finding rate on null recordings: %d/%d = %.1f %% (goal <= 5 %%)\n",
-                r.null_findings, r.nulls, r.nulls ? 100.0 * r.null_findings / r.nulls : 0.0);
-  o += buf;
-  std::snprintf(buf, sizeof buf, "Found below 1x threshold (for reference): %d/%d\n",
-                r.below1x_found, r.below1x);
-  o += buf;
-  std::snprintf(buf, sizeof buf,
+                "%d/%d = %.1f %% (goal >= 95 %%)\n"
+                "False-finding rate on null recordings: %d/%d = %.1f %% (goal <= 5 %%)\n"
+                "Found below 1x threshold (for reference): %d/%d\n"
                 "Not scored (threshold beyond a physical damping change in that design): %d\n",
-                r.unscored);
+                r.above2x_hits, r.above2x, pct(r.above2x_hits, r.above2x), r.null_findings, r.nulls,
+                pct(r.null_findings, r.nulls), r.below1x_found, r.below1x, r.unscored);
   o += buf;
   o += "By campaign design:\n";
   for (Design kind : {Design::ringdown, Design::telemetry, Design::firmware}) {
@@ -509,7 +538,14 @@ std::string format_benchmark(const BenchResult& r) {
                   bench::design_name(kind), hits, above, null_found, nulls);
     o += buf;
   }
-  // Confusable pairs of the catalogue.
+  return o;
+}
+
+// Confusable pairs of the catalogue, and pickoff effects the baseline's own
+// parameters absorbed (a miss above 2x with no finding).
+std::string format_confusable(const BenchResult& r) {
+  std::string o;
+  char buf[256];
   struct Pair {
     Effect a, b;
   };
@@ -529,8 +565,6 @@ std::string format_benchmark(const BenchResult& r) {
                   effect_info(p.b).id, r.confusion[ia][ib], na, r.confusion[ib][ia], nb);
     o += buf;
   }
-  // Against the baseline's own parameters: a miss above 2x means the
-  // baseline (damping anisotropy, split) absorbed the effect.
   o += "Against the baseline (effect above 2x threshold absorbed, no finding):\n";
   for (Effect e : {Effect::pickoff_gain_mismatch, Effect::pickoff_phase_mismatch,
                    Effect::pickoff_misalignment}) {
@@ -546,10 +580,17 @@ std::string format_benchmark(const BenchResult& r) {
                   miss, n);
     o += buf;
   }
-  o += format_beyond_catalogue(r);
-  std::snprintf(buf, sizeof buf, "\nMean audit time per recording: %.2f s\n", r.mean_audit_s);
-  o += buf;
   return o;
+}
+
+}  // namespace
+
+std::string format_benchmark(const BenchResult& r) {
+  std::string o =
+      format_confusion(r) + format_rates(r) + format_confusable(r) + format_beyond_catalogue(r);
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "\nMean audit time per recording: %.2f s\n", r.mean_audit_s);
+  return o + buf;
 }
 
 }  // namespace hrg::audit

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "audit/audit.hpp"
 #include "audit/audit_command.hpp"
@@ -33,8 +35,9 @@ void bench_usage(std::FILE* f) {
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
-               "writes one simulated campaign, optionally with one catalogue effect (a\n"
-               "firmware campaign lasts as long as its table turn; --duration is ignored),\n"
+               "writes one simulated campaign, optionally with catalogue effects (--effect\n"
+               "repeated; a firmware campaign lasts as long as its table turn; --duration is\n"
+               "ignored),\n"
                "1/f noise, one effect outside the catalogue (gain_ratio_drift 1/h,\n"
                "phase_drift rad/h, offset_x V, gain_ratio_vs_temperature 1/degC) and a\n"
                "reference that follows the resonance (f_ref_hz per row).\n");
@@ -71,99 +74,116 @@ double speed_run(double hours, uint64_t seed) {
   return secs;
 }
 
+// The command line: the benchmark's options, or one recording to emit.
+struct BenchArgs {
+  BenchOptions o;
+  double hours = 1.0;
+  std::string emit, design = "ringdown", outside;
+  std::vector<std::pair<std::string, double>> effects;  // --effect ID VALUE, repeatable
+  double duration_s = 480.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
+  bool pll = false;
+};
+
+// Reads the option at args[i] (and its values); false with a message when
+// it is unknown or its value is not one.
+bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
+  const std::string_view a = args[i];
+  const bool has_value = i + 1 < args.size();
+  if (a == "--n" && has_value) {
+    b.o.designs = std::atoi(args[++i]);
+  } else if (a == "--jobs" && has_value) {
+    if (!batch::parse_jobs(args[++i], b.o.jobs)) {
+      std::fprintf(stderr, "hrg audit-bench: --jobs '%s' is not a count (0: all cores)\n", args[i]);
+      return false;
+    }
+  } else if (a == "--seed" && has_value) {
+    b.o.seed = std::strtoull(args[++i], nullptr, 10);
+  } else if (a == "--speed-hours" && has_value) {
+    b.hours = std::atof(args[++i]);
+  } else if (a == "--emit" && has_value) {
+    b.emit = args[++i];
+  } else if (a == "--design" && has_value) {
+    b.design = args[++i];
+  } else if (a == "--noise" && has_value) {
+    b.noise_v = std::atof(args[++i]);
+  } else if (a == "--duration" && has_value) {
+    b.duration_s = std::atof(args[++i]);
+  } else if (a == "--effect" && i + 2 < args.size()) {
+    const std::string id = args[++i];
+    b.effects.emplace_back(id, std::atof(args[++i]));
+  } else if (a == "--flicker" && has_value) {
+    b.flicker_hz = std::atof(args[++i]);
+  } else if (a == "--outside" && i + 2 < args.size()) {
+    b.outside = args[++i];
+    b.outside_value = std::atof(args[++i]);
+  } else if (a == "--pll") {
+    b.pll = true;
+  } else if (a == "--verbose") {
+    b.o.verbose = true;
+  } else {
+    std::fprintf(stderr, "hrg audit-bench: unexpected argument '%s'\n", args[i]);
+    bench_usage(stderr);
+    return false;
+  }
+  return true;
+}
+
+// One simulated campaign written as a recording (for looking at by hand).
+int emit_recording(const BenchArgs& b) {
+  bench::Design design = bench::Design::ringdown;
+  if (!parse_design(b.design, design)) {
+    std::fprintf(stderr,
+                 "hrg audit-bench: unknown --design '%s' (ringdown, telemetry or firmware)\n",
+                 b.design.c_str());
+    return 2;
+  }
+  auto sc = bench::random_scenario(design, b.duration_s, b.o.seed);
+  for (const auto& [id, value] : b.effects) {
+    if (!bench::conceal_by_id(sc, id, value, b.o.seed)) {
+      std::fprintf(stderr, "hrg audit-bench: unknown effect '%s'\n", id.c_str());
+      return 2;
+    }
+  }
+  if (b.noise_v >= 0.0) sc.noise_v = b.noise_v;
+  sc.flicker_corner_hz = b.flicker_hz;
+  sc.pll_reference = b.pll;
+  if (!b.outside.empty() && !bench::outside_by_name(b.outside, sc.outside)) {
+    std::fprintf(stderr, "hrg audit-bench: unknown --outside shape '%s'\n", b.outside.c_str());
+    return 2;
+  }
+  sc.outside_value = b.outside_value;
+  recording::write_recording(b.emit, bench::simulate(sc));
+  std::printf("wrote %s (f %.6f Hz, Q %.4g, dmu %.4g, split %.4g Hz, noise %.3g V)\n",
+              b.emit.c_str(), sc.resonator.f_hz, sc.resonator.q, sc.resonator.dmu,
+              sc.resonator.split_hz, sc.noise_v);
+  return 0;
+}
+
 }  // namespace
 
 int audit_bench_main(std::span<char* const> args) {
-  BenchOptions o;
-  o.jobs = batch::all_cores();
-  double hours = 1.0;
-  std::string emit, design_arg = "ringdown", effect;
-  double duration_s = 480.0, value = 0.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
-  std::string outside;
-  bool pll = false;
+  BenchArgs b;
+  b.o.jobs = batch::all_cores();
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string_view a = args[i];
-    const bool has_value = i + 1 < args.size();
     if (a == "--help" || a == "-h") {
       bench_usage(stdout);
       return 0;
-    } else if (a == "--n" && has_value) {
-      o.designs = std::atoi(args[++i]);
-    } else if (a == "--jobs" && has_value) {
-      if (!batch::parse_jobs(args[++i], o.jobs)) {
-        std::fprintf(stderr, "hrg audit-bench: --jobs '%s' is not a count (0: all cores)\n",
-                     args[i]);
-        return 2;
-      }
-    } else if (a == "--seed" && has_value) {
-      o.seed = std::strtoull(args[++i], nullptr, 10);
-    } else if (a == "--speed-hours" && has_value) {
-      hours = std::atof(args[++i]);
-    } else if (a == "--emit" && has_value) {
-      emit = args[++i];
-    } else if (a == "--design" && has_value) {
-      design_arg = args[++i];
-    } else if (a == "--noise" && has_value) {
-      noise_v = std::atof(args[++i]);
-    } else if (a == "--duration" && has_value) {
-      duration_s = std::atof(args[++i]);
-    } else if (a == "--effect" && i + 2 < args.size()) {
-      effect = args[++i];
-      value = std::atof(args[++i]);
-    } else if (a == "--flicker" && has_value) {
-      flicker_hz = std::atof(args[++i]);
-    } else if (a == "--outside" && i + 2 < args.size()) {
-      outside = args[++i];
-      outside_value = std::atof(args[++i]);
-    } else if (a == "--pll") {
-      pll = true;
-    } else if (a == "--verbose") {
-      o.verbose = true;
-    } else {
-      std::fprintf(stderr, "hrg audit-bench: unexpected argument '%s'\n", args[i]);
-      bench_usage(stderr);
-      return 2;
     }
+    if (!parse_option(args, i, b)) return 2;
   }
-  if (!emit.empty()) {
-    // One simulated campaign written as a recording (for looking at by hand).
-    bench::Design design = bench::Design::ringdown;
-    if (!parse_design(design_arg, design)) {
-      std::fprintf(stderr,
-                   "hrg audit-bench: unknown --design '%s' (ringdown, telemetry or firmware)\n",
-                   design_arg.c_str());
-      return 2;
-    }
-    auto sc = bench::random_scenario(design, duration_s, o.seed);
-    if (!effect.empty() && !bench::conceal_by_id(sc, effect, value, o.seed)) {
-      std::fprintf(stderr, "hrg audit-bench: unknown effect '%s'\n", effect.c_str());
-      return 2;
-    }
-    if (noise_v >= 0.0) sc.noise_v = noise_v;
-    sc.flicker_corner_hz = flicker_hz;
-    sc.pll_reference = pll;
-    if (!outside.empty() && !bench::outside_by_name(outside, sc.outside)) {
-      std::fprintf(stderr, "hrg audit-bench: unknown --outside shape '%s'\n", outside.c_str());
-      return 2;
-    }
-    sc.outside_value = outside_value;
-    recording::write_recording(emit, bench::simulate(sc));
-    std::printf("wrote %s (f %.6f Hz, Q %.4g, dmu %.4g, split %.4g Hz, noise %.3g V)\n",
-                emit.c_str(), sc.resonator.f_hz, sc.resonator.q, sc.resonator.dmu,
-                sc.resonator.split_hz, sc.noise_v);
-    return 0;
-  }
-  if (o.designs < 0) {
+  if (!b.emit.empty()) return emit_recording(b);
+  if (b.o.designs < 0) {
     std::fprintf(stderr, "hrg audit-bench: --n must not be negative\n");
     return 2;
   }
-  if (o.designs > 0) {
-    const BenchResult r = run_benchmark(o);
-    std::printf("hrg audit benchmark: %d designs, seed %llu, %zu recordings\n\n", o.designs,
-                static_cast<unsigned long long>(o.seed), r.cases.size());
+  if (b.o.designs > 0) {
+    const BenchResult r = run_benchmark(b.o);
+    std::printf("hrg audit benchmark: %d designs, seed %llu, %zu recordings\n\n", b.o.designs,
+                static_cast<unsigned long long>(b.o.seed), r.cases.size());
     std::fputs(format_benchmark(r).c_str(), stdout);
   }
-  if (hours > 0.0) speed_run(hours, o.seed);
+  if (b.hours > 0.0) speed_run(b.hours, b.o.seed);
   return 0;
 }
 

@@ -57,11 +57,20 @@ struct AuditOptions {
   // Evidence for a generic description term (delta BIC): a search over many
   // shapes needs more than one catalogue candidate.
   double min_description_bic = 20.0;
-  // A description term must lower the mean-square residual per sample by at
-  // least this share of the noise variance (its slow part included):
-  // smaller structure is not described (it stays in the locations).
-  double min_description_share = 0.1;
+  // A description term must remove at least this share of the baseline's
+  // misfit beyond the noise (chi^2 minus its count; all of it when the
+  // baseline is at the noise): a trace of model error beside a large
+  // catalogue effect is not described (it stays in the locations).
+  double min_description_share = 0.05;
+  // With noise slower than the AR model follows (its variance at long lags
+  // above 1.2x the white level), a term must also lower the mean-square
+  // residual by this share of the noise variance, its slow part included.
+  double min_description_fall = 0.1;
   int max_description_terms = 3;
+  // Noise model of the tests: residuals whitened by an AR model per channel
+  // (true) or white residuals counted at the effective sample count from
+  // their integrated autocorrelation (false).
+  bool ar_whitening = true;
 };
 
 struct Location {

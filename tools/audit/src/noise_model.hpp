@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The residual noise model of the significance and acceptance tests: an
+// autoregressive (AR) model per residual channel (re/im of x and y, one value
+// per block), its order chosen by BIC, fitted to the residuals of the model a
+// test accepts. Coloured noise (1/f-like on the demodulated signals) is then
+// whitened before chi^2 is counted, so slow noise is not taken for structure.
+
+#include <array>
+#include <vector>
+
+#include "dataset.hpp"
+
+namespace hrg::audit::detail {
+
+struct ArNoise {
+  static constexpr int kMaxOrder = 6;
+  // Per channel and per order q = 0..p (p the chosen order): a_1..a_q of
+  // r_t = sum a_k r_{t-k} + e_t and var(e) in noise units^2. The first rows
+  // of a segment are predicted with the orders their lags allow.
+  struct Order {
+    std::vector<double> coef;
+    double var = 1.0;
+  };
+  std::array<std::vector<Order>, 4> orders;
+  int order(std::size_t channel) const {
+    return orders[channel].empty() ? 0 : static_cast<int>(orders[channel].size()) - 1;
+  }
+};
+
+// AR model of the free-decay block residuals `res` (4 per block, segments in
+// the order of d.free), fitted per channel by pooled least squares over the
+// segments; order 0..kMaxOrder by BIC on a common sample.
+ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res);
+
+// chi^2 of the free-decay residuals after whitening with `ar` (each channel's
+// prediction error over its innovation variance; the first rows of a segment
+// use the lags they have), plus the excitation-segment residuals unchanged.
+double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArNoise& ar);
+
+}  // namespace hrg::audit::detail
