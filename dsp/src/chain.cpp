@@ -193,7 +193,7 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
   const Quadratures<double> q{Ops::to_f64(qs.cx) * fs_v, Ops::to_f64(qs.sx) * fs_v,
                               Ops::to_f64(qs.cy) * fs_v, Ops::to_f64(qs.sy) * fs_v};
   const WaveVariables<double> w = wave_variables(q);
-  out_.quad = q;
+  out_.quad_v = q;
   out_.wave = w;
   out_.theta_A_rad = unwrap_.update(w.theta_A_rad);
   out_.phase_err_rad = w.phase_rad;
@@ -213,14 +213,14 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
 
 template <typename T>
 void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
-  const bool valid = w.a_A > cfg_.min_amplitude_v;
+  const bool valid = w.a_A_v > cfg_.min_amplitude_v;
   // Geometry of the drive: the pattern axis and the full wave phase (the
   // sign of the projection on the axis resolves the pi ambiguity of phase_rad).
   if (valid) {
     c2_ = std::cos(2.0 * w.theta_A_rad);
     s2_ = std::sin(2.0 * w.theta_A_rad);
-    const double c_a = out_.quad.cx * c2_ + out_.quad.cy * s2_;
-    const double s_a = out_.quad.sx * c2_ + out_.quad.sy * s2_;
+    const double c_a = out_.quad_v.cx * c2_ + out_.quad_v.cy * s2_;
+    const double s_a = out_.quad_v.sx * c2_ + out_.quad_v.sy * s2_;
     wave_phase_rad_ = std::atan2(-s_a, c_a);
   }
   out_.pll_freq_hz = pll_.update(w.phase_rad, valid, dt_s);
@@ -228,8 +228,8 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
   out_.excitation = pump_on_ || forcers_on_;
 
   const double a_set = agc_.setpoint_v();
-  if (ring_up_ && w.a_A > cfg_.ring_up_exit * a_set) ring_up_ = false;
-  if (!ring_up_ && w.a_A < cfg_.ring_up_enter * a_set) ring_up_ = true;
+  if (ring_up_ && w.a_A_v > cfg_.ring_up_exit * a_set) ring_up_ = false;
+  if (!ring_up_ && w.a_A_v < cfg_.ring_up_enter * a_set) ring_up_ = true;
   // Pump: at its limit during ring-up (once there is a wave to pump), else
   // the AGC. Off: zero, AGC holds.
   v0_v_ = 0.0;
@@ -237,7 +237,7 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
     if (ring_up_) {
       v0_v_ = valid ? cfg_.pump_max_v : 0.0;
     } else {
-      v0_v_ = agc_.update(w.a_A, dt_s);
+      v0_v_ = agc_.update(w.a_A_v, dt_s);
     }
   }
   // Forcers: direct drive at resonance along the pattern during ring-up (the
@@ -248,14 +248,15 @@ void Chain<T>::update_loops(const WaveVariables<double>& w, double dt_s) {
     if (ring_up_) {
       u_a_v_ = cfg_.forcer_max_v;
     } else {
-      u_q_v_ = quad_pi_.update(-w.a_B, dt_s);
+      u_q_v_ = quad_pi_.update(-w.a_B_v, dt_s);
     }
     if (pattern_enabled_ && valid) {
       const double w_rad_s = 2.0 * kPi * out_.pll_freq_hz;
       const double rate =
           clamp_abs(cfg_.pattern_gain_per_s * (pattern_target_rad_ - out_.theta_A_rad),
                     pattern_max_rate_rad_s_);
-      u_r_v_ = clamp_abs(4.0 * w_rad_s * w.a_A * rate / cfg_.forcer_gain_per_s2, cfg_.forcer_max_v);
+      u_r_v_ =
+          clamp_abs(4.0 * w_rad_s * w.a_A_v * rate / cfg_.forcer_gain_per_s2, cfg_.forcer_max_v);
     }
   }
   out_.ring_up = ring_up_;

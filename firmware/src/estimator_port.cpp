@@ -11,16 +11,16 @@ namespace {
 // see dsp/, so the chain's record is translated here and nowhere else).
 est::WaveSample wave_sample(const ChainRecord& s) {
   return {.t_s = s.t_s,
-          .a_A_v = s.wave.a_A,
-          .a_B_v = s.wave.a_B,
+          .a_A_v = s.wave.a_A_v,
+          .a_B_v = s.wave.a_B_v,
           .theta_A_rad = s.theta_A_rad,
-          .E_v2 = s.wave.E};
+          .E_v2 = s.wave.E_v2};
 }
 
 est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s) {
   return {.t_s = s.t_s,
-          .a_A_v = s.wave.a_A,
-          .a_B_v = s.wave.a_B,
+          .a_A_v = s.wave.a_A_v,
+          .a_B_v = s.wave.a_B_v,
           .theta_A_rad = s.theta_A_rad,
           .pump_phase_error_rad = s.pump_phase_error_rad,
           .quad_force_sin_v_s = s.quad_force_sin_v_s,

@@ -91,9 +91,10 @@ void Gyro::task_chain(Gyro& g) {
 
 bool Gyro::in_bands() const {
   const ChainRecord& o = status_.chain;
-  if (!o.locked || cfg_.amplitude_set_v <= 0.0 || o.wave.a_A <= 0.0) return false;
-  const double amp_err = std::fabs(o.wave.a_A - cfg_.amplitude_set_v) / cfg_.amplitude_set_v;
-  return amp_err < cfg_.amplitude_band && std::fabs(o.wave.a_B / o.wave.a_A) < cfg_.quadrature_band;
+  if (!o.locked || cfg_.amplitude_set_v <= 0.0 || o.wave.a_A_v <= 0.0) return false;
+  const double amp_err = std::fabs(o.wave.a_A_v - cfg_.amplitude_set_v) / cfg_.amplitude_set_v;
+  return amp_err < cfg_.amplitude_band &&
+         std::fabs(o.wave.a_B_v / o.wave.a_A_v) < cfg_.quadrature_band;
 }
 
 void Gyro::step_mode_progress(const WindowDecision& d) {
@@ -105,7 +106,7 @@ void Gyro::step_mode_progress(const WindowDecision& d) {
       }
       break;
     case Mode::ring_up:
-      if (o.wave.a_A >= (1.0 - cfg_.amplitude_band) * cfg_.amplitude_set_v) {
+      if (o.wave.a_A_v >= (1.0 - cfg_.amplitude_band) * cfg_.amplitude_set_v) {
         mode_.handle(Event::amplitude_reached);
       }
       break;
@@ -136,7 +137,7 @@ void Gyro::task_supervise(Gyro& g) {
   (void)g.board_.fault_input.read(fault_in);
   g.status_.fault_input = fault_in;
   MonitorInputs in;
-  in.amplitude_v = g.status_.chain.wave.a_A;
+  in.amplitude_v = g.status_.chain.wave.a_A_v;
   in.pll_locked = g.status_.chain.locked;
   in.adc_clipped = g.adc_clipped_;
   in.adc_samples = static_cast<uint32_t>(g.adc_.size());
@@ -219,7 +220,7 @@ void Gyro::task_output(Gyro& g) {
     --g.pattern_hold_frames_;
   }
   if (moving_on_purpose) g.output_.rereference();
-  const double ratio = o.wave.a_A > 0.0 ? o.wave.a_B / o.wave.a_A : 0.0;
+  const double ratio = o.wave.a_A_v > 0.0 ? o.wave.a_B_v / o.wave.a_A_v : 0.0;
   // The model is applied once the campaign has ended (conditioning and
   // coverage good): an early solution from a few windows at nearby angles
   // would add more error than it removes.
@@ -285,8 +286,8 @@ void Gyro::task_telemetry(Gyro& g) {
   const GyroStatus& st = g.status_;
   can::TelemetrySnapshot& s = g.snapshot_;
   g.envelope_.after_block(st.chain.t_s, st.chain.nco_phase, st.excitation_on);
-  const can::EnvelopeRow row =
-      g.envelope_.row(st.chain.quad.cx, st.chain.quad.sx, st.chain.quad.cy, st.chain.quad.sy);
+  const can::EnvelopeRow row = g.envelope_.row(st.chain.quad_v.cx, st.chain.quad_v.sx,
+                                               st.chain.quad_v.cy, st.chain.quad_v.sy);
   s.cx_v = row.cx_v;
   s.sx_v = row.sx_v;
   s.cy_v = row.cy_v;

@@ -47,20 +47,20 @@ WaveState wave_state(cplx x, cplx y) {
   w.theta_rad = std::atan2(w.s_v2, w.r_v2) / 4.0;
   const double plus = std::sqrt(std::max(0.0, w.energy_v2 + w.quad_v2));
   const double minus = std::sqrt(std::max(0.0, w.energy_v2 - w.quad_v2));
-  w.a_a_v = 0.5 * (plus + minus);
-  w.a_b_v = 0.5 * (plus - minus);
+  w.a_A_v = 0.5 * (plus + minus);
+  w.a_B_v = 0.5 * (plus - minus);
   const cplx along = x * std::cos(2.0 * w.theta_rad) + y * std::sin(2.0 * w.theta_rad);
   w.phase_a_rad = std::arg(along);
   return w;
 }
 
-void standing_wave(double a_a_v, double theta_rad, double a_b_v, double phase_rad, cplx& x_env,
+void standing_wave(double a_A_v, double theta_rad, double a_B_v, double phase_rad, cplx& x_env,
                    cplx& y_env) {
   const double c = std::cos(2.0 * theta_rad);
   const double s = std::sin(2.0 * theta_rad);
   const cplx rot = std::polar(1.0, phase_rad);
-  x_env = rot * (a_a_v * c + kI * a_b_v * s);
-  y_env = rot * (a_a_v * s - kI * a_b_v * c);
+  x_env = rot * (a_A_v * c + kI * a_B_v * s);
+  y_env = rot * (a_A_v * s - kI * a_B_v * c);
 }
 
 void measure_envelopes(const Effects& fx, cplx x_env, cplx y_env, cplx pump_env_v, cplx& x_meas,
@@ -117,11 +117,11 @@ void AveragedModel::set_drive(const EnvelopeDrive& drive) {
   dirty_ = true;
 }
 
-void AveragedModel::set_standing_wave(double a_a_v, double theta_rad, double a_b_v,
+void AveragedModel::set_standing_wave(double a_A_v, double theta_rad, double a_B_v,
                                       double phase_rad) {
   cplx x;
   cplx y;
-  standing_wave(a_a_v, theta_rad, a_b_v, phase_rad, x, y);
+  standing_wave(a_A_v, theta_rad, a_B_v, phase_rad, x, y);
   set_envelopes(x, y);
 }
 

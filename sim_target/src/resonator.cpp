@@ -92,10 +92,10 @@ void Resonator::set_envelopes(std::complex<double> x_env, std::complex<double> y
             (i_w * y_env * carrier).real());
 }
 
-void Resonator::set_standing_wave(double a_a_v, double theta_rad, double a_b_v, double phase_rad) {
+void Resonator::set_standing_wave(double a_A_v, double theta_rad, double a_B_v, double phase_rad) {
   std::complex<double> x;
   std::complex<double> y;
-  standing_wave(a_a_v, theta_rad, a_b_v, phase_rad, x, y);
+  standing_wave(a_A_v, theta_rad, a_B_v, phase_rad, x, y);
   set_envelopes(x, y);
 }
 

@@ -102,8 +102,8 @@ TrueState SimTarget::true_state() const {
   s.pattern_angle_rad = pattern_angle_rad_ + std::remainder(w.theta_rad - last_theta_rad_, kPi / 2);
   s.input_angle_rad = input_angle_rad_;
   s.energy_v2 = w.energy_v2;
-  s.a_a_v = w.a_a_v;
-  s.a_b_v = w.a_b_v;
+  s.a_A_v = w.a_A_v;
+  s.a_B_v = w.a_B_v;
   s.rate_rad_s = resonator_.rate_rad_s();
   s.temp_c = resonator_.temperature_c();
   s.excitation_enabled = excitation_.value;

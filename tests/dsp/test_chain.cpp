@@ -129,7 +129,7 @@ TEST(Chain, DrivesAreExactlyZeroWhileExcitationIsOff) {
     }
   }
   // and the measurement still runs (the wave is seen, the PLL tracks it)
-  DOUBLES_EQUAL(0.3 * 2.0, chain.outputs().wave.a_A, 1e-4);
+  DOUBLES_EQUAL(0.3 * 2.0, chain.outputs().wave.a_A_v, 1e-4);
   // WHEN excitation is switched on the pump comes on
   chain.set_excitation(true);
   chain.process(tone_block(100, 5000.0, 0.3, 0.05), dac);

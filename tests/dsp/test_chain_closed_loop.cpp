@@ -82,7 +82,7 @@ TEST(ClosedLoop, PllTracksAHalfHertzPerSecondRampWithinOneMilliradian) {
     CHECK(rig.out().locked);
     DOUBLES_EQUAL(5000.0 + 2.0 * sign, rig.out().pll_freq_hz, 0.01);
     // and the amplitude loop is not disturbed by the moving frequency
-    DOUBLES_EQUAL(1.0, rig.out().wave.a_A, 1e-4);
+    DOUBLES_EQUAL(1.0, rig.out().wave.a_A_v, 1e-4);
   }
 }
 
@@ -99,10 +99,10 @@ TEST(ClosedLoop, AgcHoldsTheAmplitudeAndQuadratureIsNulledInSteadyState) {
     // WHEN the loops have settled, over the next 3 s
     rig.run(3.0, [&] {
       const auto& w = rig.out().wave;
-      worst_a = std::fmax(worst_a, std::fabs(w.a_A - 1.0));
-      worst_q = std::fmax(worst_q, std::fabs(w.a_B / w.a_A));
+      worst_a = std::fmax(worst_a, std::fabs(w.a_A_v - 1.0));
+      worst_q = std::fmax(worst_q, std::fabs(w.a_B_v / w.a_A_v));
       const auto t = true_wave(rig.resonator());
-      worst_true_q = std::fmax(worst_true_q, std::fabs(t.a_B / t.a_A));
+      worst_true_q = std::fmax(worst_true_q, std::fabs(t.a_B_v / t.a_A_v));
     });
     // and the pump works at its best phase: V0 is the parametric threshold
     // sqrt(8 w nu_A / k_pump) of wave A (nu_A = nu (1 + dmu cos 4theta)),
@@ -136,7 +136,7 @@ TEST(ClosedLoop, PumpPhaseOfPiOverFourAddsEnergyToWaveA) {
     rig.chain().set_excitation(true);
     rig.run(t_s);
     v0 = rig.out().pump_v;
-    a_a = rig.out().wave.a_A;
+    a_a = rig.out().wave.a_A_v;
   };
   double v0_best = 0, a = 0;
   settle(kPi / 4, 4.0, v0_best, a);
@@ -196,11 +196,11 @@ TEST(ClosedLoop, LoopsHoldWithPickoffNoise) {
   bool always_locked = true;
   long n = 0;
   rig.run(4.0, [&] {
-    const double a = true_wave(rig.resonator()).a_A;
+    const double a = true_wave(rig.resonator()).a_A_v;
     sum_a += a;
     sum_a2 += a * a;
     ++n;
-    worst_true_q = std::fmax(worst_true_q, std::fabs(true_wave(rig.resonator()).a_B));
+    worst_true_q = std::fmax(worst_true_q, std::fabs(true_wave(rig.resonator()).a_B_v));
     worst_phase = std::fmax(worst_phase, std::fabs(rig.out().phase_err_rad));
     always_locked = always_locked && rig.out().locked;
   });
@@ -235,16 +235,16 @@ TEST(ClosedLoop, LoopsRecoverWithinOneSecondAfterATwoSecondFreeDecayWindow) {
     rig.chain().set_excitation(false);
     rig.run(2.0);
     const auto& w = rig.out().wave;
-    worst_decay = std::fmax(worst_decay, 1.0 - w.a_A);
-    worst_growth = std::fmax(worst_growth, std::fabs(w.a_B / w.a_A));
+    worst_decay = std::fmax(worst_decay, 1.0 - w.a_A_v);
+    worst_growth = std::fmax(worst_growth, std::fabs(w.a_B_v / w.a_A_v));
     // THEN, with excitation back on, the loops settle within 1 s
     rig.chain().set_excitation(true);
     const double t_on = rig.time_s();
     double last_bad_s = 0.0, overshoot = 0.0;
     rig.run(1.5, [&] {
       const auto& o = rig.out().wave;
-      overshoot = std::fmax(overshoot, o.a_A - 1.0);
-      if (std::fabs(o.a_A - 1.0) > 1e-4 || std::fabs(o.a_B / o.a_A) > 1e-4)
+      overshoot = std::fmax(overshoot, o.a_A_v - 1.0);
+      if (std::fabs(o.a_A_v - 1.0) > 1e-4 || std::fabs(o.a_B_v / o.a_A_v) > 1e-4)
         last_bad_s = rig.time_s() - t_on;
     });
     CHECK(last_bad_s < 1.0);
@@ -290,9 +290,9 @@ TEST(ClosedLoop, RingsUpFromRestAndHandsOverToThePump) {
     std::printf(
         "\n  ring-up from rest, NCO %+.0f Hz off, to 0.9 x %.2f V: %.2f s (predicted %.2f s); "
         "a_A %.6f V\n",
-        offset_hz, a_set, handover_s, predicted_s, rig.out().wave.a_A);
+        offset_hz, a_set, handover_s, predicted_s, rig.out().wave.a_A_v);
     DOUBLES_EQUAL(predicted_s, handover_s, 0.05 * predicted_s);
-    DOUBLES_EQUAL(a_set, rig.out().wave.a_A, a_set * 1e-4);
+    DOUBLES_EQUAL(a_set, rig.out().wave.a_A_v, a_set * 1e-4);
     // (once rung up the pattern is free: the damping drift nu dmu sin4theta / 2
     // moves it by up to 7.9e-5 rad/s, 3.5e-3 rad over 45 s)
     const double t_run = a_set < 0.5 ? 12.0 : 45.0;
@@ -345,8 +345,8 @@ TEST(ClosedLoop, PatternFollowsTheInputRateWithAllLoopsClosed) {
         cm1.feed(prev_t, prev_m, t, m);
         cr0.feed(prev_t, prev_r, t, r);
         cr1.feed(prev_t, prev_r, t, r);
-        worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
-        worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
+        worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A_v - 1.0));
+        worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B_v));
         prev_t = t;
         prev_m = m;
         prev_r = r;
@@ -420,8 +420,8 @@ TEST(ClosedLoop, PatternCommandTurnsThePatternOnPurposeAndHoldsIt) {
     const double th_start = rig.out().theta_A_rad;
     double worst_a = 0.0, worst_q = 0.0, mid_rate = 0.0;
     rig.run(10.0, [&] {
-      worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
-      worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
+      worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A_v - 1.0));
+      worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B_v));
       if (std::fabs(rig.time_s() - 3.5) < 0.5e-3)
         mid_rate = (rig.out().theta_A_rad - th_start) / (rig.time_s() - 0.5);
     });
@@ -465,8 +465,8 @@ TEST(ClosedLoop, FloatChainClosesTheSameLoops) {
   // THEN it holds the same figures as the fixed-point chain
   double worst_a = 0.0, worst_q = 0.0;
   rig.run(2.0, [&] {
-    worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A - 1.0));
-    worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B));
+    worst_a = std::fmax(worst_a, std::fabs(rig.out().wave.a_A_v - 1.0));
+    worst_q = std::fmax(worst_q, std::fabs(rig.out().wave.a_B_v));
   });
   std::printf("\n  float chain: |a_A - 1| %.1e, |a_B| %.1e after a window\n", worst_a, worst_q);
   CHECK(rig.out().locked);

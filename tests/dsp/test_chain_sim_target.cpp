@@ -45,8 +45,8 @@ TEST(ChainOnSimTarget, HoldsTheWaveWithThePumpAtItsBestPhase) {
       CHECK(chain.process(adc, dac));
       CHECK(b.dac.write_block(dac) == hal::Status::ok);
       if (k >= 2000) {
-        worst_a = std::fmax(worst_a, std::fabs(chain.outputs().wave.a_A - 1.0));
-        worst_q = std::fmax(worst_q, std::fabs(target.true_state().a_b_v));
+        worst_a = std::fmax(worst_a, std::fabs(chain.outputs().wave.a_A_v - 1.0));
+        worst_q = std::fmax(worst_q, std::fabs(target.true_state().a_B_v));
       }
     }
     // THEN amplitude and quadrature are held and V0 is the parametric

@@ -142,12 +142,12 @@ TEST(PickoffCorrection, GainMismatchFourThetaReadoutErrorIsRemoved) {
     const Case c = measure(fx, a, 0.0, theta, 0.3);
     const auto raw = wave_variables(c.measured);
     raw_deg = std::max(raw_deg, std::fabs(raw.theta_A_rad - theta) / kDeg);
-    raw_level = std::max(raw_level, raw.E / (a * a) - 1.0);
+    raw_level = std::max(raw_level, raw.E_v2 / (a * a) - 1.0);
     QuadSample<q31_t> q = to_q31(c.measured);
     correct_pickoffs_q31(kq, q);
     const auto w = wave_variables(of_q31(q));
     fixed_deg = std::max(fixed_deg, std::fabs(w.theta_A_rad - theta) / kDeg);
-    fixed_level = std::max(fixed_level, std::fabs(w.E / (a * a) - 1.0));
+    fixed_level = std::max(fixed_level, std::fabs(w.E_v2 / (a * a) - 1.0));
   }
   DOUBLES_EQUAL(g / 4.0 / kDeg, raw_deg, 0.003);  // 0.1432 deg
   DOUBLES_EQUAL(2.0 * g + g * g, raw_level, 1e-6);

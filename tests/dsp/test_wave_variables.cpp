@@ -46,15 +46,15 @@ TEST(WaveVariables, RecoverAmplitudesAngleAndPhaseOfAnySampledPattern) {
         // WHEN the quadratures come from sampling and projecting the pickoffs
         const auto w = wave_variables(demodulate_by_definition(a_A, a_B, th, phi));
         // THEN the physics.md identities hold
-        DOUBLES_EQUAL(a_A * a_A + a_B * a_B, w.E, 1e-12);
-        DOUBLES_EQUAL(2 * a_A * a_B, w.Q, 1e-12);
-        DOUBLES_EQUAL((a_A * a_A - a_B * a_B) * std::cos(4 * th), w.R, 1e-12);
-        DOUBLES_EQUAL((a_A * a_A - a_B * a_B) * std::sin(4 * th), w.S, 1e-12);
-        DOUBLES_EQUAL(a_A, w.a_A, 1e-12);
-        DOUBLES_EQUAL(a_B, w.a_B, 1e-12);
+        DOUBLES_EQUAL(a_A * a_A + a_B * a_B, w.E_v2, 1e-12);
+        DOUBLES_EQUAL(2 * a_A * a_B, w.Q_v2, 1e-12);
+        DOUBLES_EQUAL((a_A * a_A - a_B * a_B) * std::cos(4 * th), w.R_v2, 1e-12);
+        DOUBLES_EQUAL((a_A * a_A - a_B * a_B) * std::sin(4 * th), w.S_v2, 1e-12);
+        DOUBLES_EQUAL(a_A, w.a_A_v, 1e-12);
+        DOUBLES_EQUAL(a_B, w.a_B_v, 1e-12);
         DOUBLES_EQUAL(th, w.theta_A_rad, 1e-12);
         DOUBLES_EQUAL(phi, w.phase_rad, 1e-12);
-        DOUBLES_EQUAL(w.E * w.E, w.R * w.R + w.S * w.S + w.Q * w.Q, 1e-12);
+        DOUBLES_EQUAL(w.E_v2 * w.E_v2, w.R_v2 * w.R_v2 + w.S_v2 * w.S_v2 + w.Q_v2 * w.Q_v2, 1e-12);
       }
     }
   }
@@ -87,13 +87,13 @@ TEST(WaveVariables, SmallQuadratureKeepsRelativePrecisionInFloat) {
   const Quadratures<float> qf{static_cast<float>(q.cx), static_cast<float>(q.sx),
                               static_cast<float>(q.cy), static_cast<float>(q.sy)};
   const auto w = wave_variables(qf);
-  DOUBLES_EQUAL(0.5e-6, w.a_B, 0.5 * 6e-8);
+  DOUBLES_EQUAL(0.5e-6, w.a_B_v, 0.5 * 6e-8);
   DOUBLES_EQUAL(0.3, w.theta_A_rad, 1e-6);
 }
 
 TEST(WaveVariables, ZeroAmplitudeGivesZeroNotNan) {
   const auto w = wave_variables(Quadratures<double>{});
-  CHECK_EQUAL(0.0, w.a_A);
+  CHECK_EQUAL(0.0, w.a_A_v);
   CHECK_EQUAL(0.0, w.theta_A_rad);
   CHECK_EQUAL(0.0, w.phase_rad);
 }

@@ -43,7 +43,7 @@ WaveSample measure(const sim::AveragedModel& m, double noise_v, Rng& rng) {
     q.sy += n(rng);
   }
   const auto w = dsp::wave_variables<double>(q);
-  return WaveSample{m.time_s(), w.a_A, w.a_B, w.theta_A_rad, w.E};
+  return WaveSample{m.time_s(), w.a_A_v, w.a_B_v, w.theta_A_rad, w.E_v2};
 }
 
 // One free-decay window: excitation off at the model's present time, samples

@@ -20,7 +20,7 @@
 #include <Eigen/Dense>
 
 #include "averaged_runner.hpp"
-#include "sim_tools/analysis.hpp"
+#include "sim_run/analysis.hpp"
 
 using namespace hrg::est;
 using namespace hrg::est::test;
@@ -34,12 +34,12 @@ constexpr double kWindowS = 5.5;
 constexpr double kChunkS = 0.05;
 constexpr double kGoalDegH = 0.05;
 
-using hrg::simtools::BiasFit;
+using hrg::sim_run::BiasFit;
 
 // IEEE 1431 fit b + A sin4th + B cos4th over the parked angles (deg/h).
 template <std::size_t N>
 BiasFit fit_parked(const double (&th)[N], const double (&y)[N]) {
-  return hrg::simtools::fit_bias_4theta(std::span<const double>(th), std::span<const double>(y));
+  return hrg::sim_run::fit_bias_4theta(std::span<const double>(th), std::span<const double>(y));
 }
 
 // Angle-dependent part of the model error, deg/h of input rate.

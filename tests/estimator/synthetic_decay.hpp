@@ -86,7 +86,7 @@ class SyntheticDecay {
       q.sy += n(rng);
     }
     const auto w = dsp::wave_variables<double>(q);
-    return WaveSample{s.t_s, w.a_A, w.a_B, w.theta_A_rad, w.E};
+    return WaveSample{s.t_s, w.a_A_v, w.a_B_v, w.theta_A_rad, w.E_v2};
   }
 
  private:

@@ -99,7 +99,7 @@ TEST(ExampleRecording, JointEstimateOfTheBaselineRingDownMatchesItsTruth) {
     }
     if (in_window) {
       const auto w = hrg::dsp::wave_variables<double>({cx, sx, cy, sy});
-      est.add_sample({t, w.a_A, w.a_B, w.theta_A_rad, w.E});
+      est.add_sample({t, w.a_A_v, w.a_B_v, w.theta_A_rad, w.E_v2});
     }
   }
   if (in_window) windows += est.end_window() == Status::ok ? 1 : 0;

@@ -129,7 +129,7 @@ TEST(MonteCarlo, AveragedModelDriftFollowsEquation6NotThePaperEquation22SplitTer
       m.advance(h);
       const sim::WaveState w1 = m.wave();
       const double d_model = 2.0 * std::remainder(w1.theta_rad - w0.theta_rad, M_PI / 2) / h;
-      const double qm = w0.a_b_v / w0.a_a_v;
+      const double qm = w0.a_B_v / w0.a_A_v;
       const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
       // the paper's eq. 22 as printed
       const double eq22 = (p(kDnuC) - 2 * qm * p(kDwC)) * s4 - (p(kDnuS) + 2 * qm * p(kDwS)) * c4;
@@ -175,8 +175,8 @@ void window_trajectory(const sim::ResonatorParams& r, int k, double a_A0, double
     m.advance(1e-3);
     if (i < 20) continue;  // the 20 ms settle time
     const sim::WaveState w = m.wave();
-    out(j++) = w.a_a_v;
-    out(j++) = w.a_b_v;
+    out(j++) = w.a_A_v;
+    out(j++) = w.a_B_v;
   }
 }
 
@@ -255,7 +255,7 @@ TEST_GROUP(ControlDriftOnAveragedModel) {
     const double h = 1e-4;
     m.advance(h);
     const double d = 2.0 * std::remainder(m.wave().theta_rad - w0.theta_rad, M_PI / 2) / h;
-    return d - resonator_drift_rad_s(p, th, w0.a_b_v / w0.a_a_v);
+    return d - resonator_drift_rad_s(p, th, w0.a_B_v / w0.a_A_v);
   }
 };
 
@@ -335,7 +335,7 @@ TEST(ControlDriftOnAveragedModel, DepumpedQuadratureWaveDriftFollowsEquation23) 
     est.add_sample({s.t_s, s.a_A_v, s.a_B_v, s.theta_A_rad, eps, 0, 0, dr.pump_v});
   }
   const sim::WaveState w = m.wave();
-  const double q = w.a_b_v / w.a_a_v;
+  const double q = w.a_B_v / w.a_A_v;
   sim::AveragedModel probe = m;
   const double truth = measured_d_phi(probe, w.theta_rad, q);
   std::printf(

@@ -46,7 +46,7 @@ WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt199
   q.sy += n(rng);
   hrg::dsp::correct_pickoffs(applied, q);
   const auto w = hrg::dsp::wave_variables<double>(q);
-  return WaveSample{s.t_s, w.a_A, w.a_B, w.theta_A_rad, w.E};
+  return WaveSample{s.t_s, w.a_A_v, w.a_B_v, w.theta_A_rad, w.E_v2};
 }
 
 // `windows` free decays of 1 s at 1 kHz, window w while the table turns at

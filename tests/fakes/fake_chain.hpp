@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <span>
 
-#include "firmware/ports.hpp"
+#include "firmware/chain_and_identifier.hpp"
 
 namespace hrg::fakes {
 
@@ -37,9 +37,9 @@ class FakeChain final : public fw::SignalChain {
                     ? err
                     : std::copysign(pattern_rate_rad_per_block, err);
     }
-    out.wave.a_A = a_a_;
-    out.wave.a_B = 0.0;
-    out.wave.E = a_a_ * a_a_;
+    out.wave.a_A_v = a_a_;
+    out.wave.a_B_v = 0.0;
+    out.wave.E_v2 = a_a_ * a_a_;
     out.theta_A_rad = theta_;  // unwrapped, as the chain gives it
     out.locked = locked;
     out.pump_v = cmd.pump_on ? 3.0 : 0.0;

@@ -6,12 +6,12 @@
 // task run happens (the executive never skips one), the gyro reaches operate.
 #include <cstdio>
 
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
 #include "support/cpputest.hpp"
 
 namespace {
-void print_tasks(const hrg::simtools::JobResult& r) {
+void print_tasks(const hrg::sim_run::RunResult& r) {
   for (const auto& t : r.tasks) {
     std::printf("  %-10s %5u Hz budget %6.1f us  max %8.1f us  mean %7.2f us  overruns %u\n",
                 t.name.c_str(), t.rate_hz, t.budget_ns / 1e3, t.max_ns / 1e3, t.mean_ns / 1e3,
@@ -29,9 +29,9 @@ void print_tasks(const hrg::simtools::JobResult& r) {
 }
 
 void run_benchmark() {
-  auto job = hrg::simtools::default_job(60.0, 16);
-  hrg::simtools::RunOptions opt;
-  const auto r = hrg::simtools::run_job(job, opt);
+  auto job = hrg::sim_run::default_run(60.0, 16);
+  hrg::sim_run::RunOptions opt;
+  const auto r = hrg::sim_run::run_simulation(job, opt);
   std::printf("\nlockstep, fs %u Hz, %.0f simulated s:\n", job.sim.adc.sample_rate_hz, r.sim_s);
   std::printf("  realtime factor %.1f x wall (%.2f s), %.1f x CPU (%.2f s); goal >= 200\n",
               r.realtime_factor, r.wall_s, r.realtime_factor_cpu, r.cpu_s);
@@ -45,9 +45,9 @@ void run_benchmark() {
   for (const auto& t : r.tasks)
     CHECK_EQUAL(frames / (hrg::fw::kBaseRateHz / t.rate_hz), t.runs);
 
-  auto rt_job = hrg::simtools::default_job(5.0, 16);
+  auto rt_job = hrg::sim_run::default_run(5.0, 16);
   opt.real_time = true;
-  const auto rt = hrg::simtools::run_job(rt_job, opt);
+  const auto rt = hrg::sim_run::run_simulation(rt_job, opt);
   std::printf("real time (CLOCK_MONOTONIC, 1 ms frames, %s), %.0f s:\n", rt.realtime_setup.c_str(),
               rt.sim_s);
   print_tasks(rt);

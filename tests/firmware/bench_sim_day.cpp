@@ -22,8 +22,8 @@
 
 #include "firmware/app/firmware.hpp"
 #include "sim_target/control.hpp"
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
 
 namespace {
 using namespace hrg;
@@ -62,11 +62,11 @@ bool parse(int argc, char** argv, Options& o) {
 
 // The model's angle-dependent bias error and its Cramer-Rao prediction (deg/h).
 void print_hour(const fw::app::Firmware& f, const sim::SimTarget& target,
-                const simtools::JobConfig& job, double noise_sigma_v) {
+                const sim_run::RunConfig& job, double noise_sigma_v) {
   const auto& est = f.estimator().estimator();
   const auto& sched = f.gyro().scheduler();
   const double k = job.firmware.gyro.angular_gain;
-  const auto truth = simtools::true_parameters(job.sim.resonator);
+  const auto truth = sim_run::true_parameters(job.sim.resonator);
   const auto& fx = job.sim.effects.thermal_damping;
   const double scale =
       fx.enabled ? 1.0 + fx.rel_per_c * (target.true_state().temp_c - job.sim.resonator.temp_ref_c)
@@ -91,7 +91,7 @@ void print_hour(const fw::app::Firmware& f, const sim::SimTarget& target,
 int main(int argc, char** argv) {
   Options o;
   if (!parse(argc, argv, o)) return 2;
-  simtools::JobConfig job = simtools::default_job(o.hours * 3600.0, 16);
+  sim_run::RunConfig job = sim_run::default_run(o.hours * 3600.0, 16);
   job.telemetry_hz = 10.0;  // the analysis needs no more; a day at 100 Hz is 2 GB of rows
   job.firmware.gyro.windows.operation_duty = o.duty;
   job.firmware.gyro.windows.operation_length_frames =
@@ -103,20 +103,20 @@ int main(int argc, char** argv) {
     job.sim.temp_c = sim::Profile::sine(2.0, 1.0 / job.duration_s, 0.0);
     job.sim.temp_c.add_offset(job.sim.resonator.temp_ref_c);
   }
-  simtools::derive_firmware_config(job);
+  sim_run::derive_firmware_config(job);
   const double adc_sigma_v = job.sim.adc.noise_v_rms[0];
   const double noise_sigma_v =
       adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.firmware.chain.block_frames));
   std::printf("%.1f h of the default scenario%s, operation duty %.1f %%, memory %s:\n", o.hours,
               o.thermal ? " with thermal damping 0.2 %/degC under a +-2 degC swing" : "",
               100.0 * o.duty, o.forgetting_s > 0 ? "set" : "derived");
-  simtools::RunOptions opt;
+  sim_run::RunOptions opt;
   opt.observe_every_s = 3600.0;
   opt.observer = [&](const fw::app::Firmware& f, const sim::SimTarget& t) {
     print_hour(f, t, job, noise_sigma_v);
   };
-  simtools::JobResult r = simtools::run_job(job, opt);
-  const bool passed = simtools::judge(job, r);
+  sim_run::RunResult r = sim_run::run_simulation(job, opt);
+  const bool passed = sim_run::judge(job, r);
   std::printf(
       "parked-angle test (%zu parks, %zu with the model valid): raw ADB %.3f, compensated "
       "ADB %.4f mean %+.4f deg/h; excitation off %.2f %%; %.0f simulated s per CPU s; "

@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -27,7 +27,7 @@ constexpr double kAdbGoalDph = 0.05;
 // first still base); continued identification adds windows only while the
 // run's share stays within the operation duty. With 5 s check windows every
 // 10 min that is 9.7 % of the hour (the campaign alone: 8.9 %).
-double excitation_off_budget(const hrg::simtools::JobConfig& job) {
+double excitation_off_budget(const hrg::sim_run::RunConfig& job) {
   const auto& w = job.firmware.gyro.windows;
   const double frame_s = 1.0 / hrg::fw::kBaseRateHz;
   const double window_s = w.length_frames * frame_s;
@@ -41,9 +41,9 @@ double excitation_off_budget(const hrg::simtools::JobConfig& job) {
 constexpr double kOffGoal = 0.10;
 
 void run_benchmark() {
-  const auto job = hrg::simtools::default_job(3600.0, 16);
-  auto r = hrg::simtools::run_job(job, {});
-  const bool passed = hrg::simtools::judge(job, r);
+  const auto job = hrg::sim_run::default_run(3600.0, 16);
+  auto r = hrg::sim_run::run_simulation(job, {});
+  const bool passed = hrg::sim_run::judge(job, r);
   for (const auto& f : r.failures)
     std::printf("  run check failed: %s\n", f.c_str());
   std::printf("\none hour of the default scenario (%.0f simulated s, %s):\n", r.sim_s,
@@ -74,8 +74,8 @@ void run_benchmark() {
                 sig > 0 ? (r.identification.p[i] - r.truth[k]) / sig : 0.0);
   }
   // The default 365 s run beside it (its campaign alone takes ~12 %).
-  const auto short_job = hrg::simtools::default_job(0.0, 16);
-  auto s = hrg::simtools::run_job(short_job, {});
+  const auto short_job = hrg::sim_run::default_run(0.0, 16);
+  auto s = hrg::sim_run::run_simulation(short_job, {});
   std::printf(
       "  default %.0f s run: excitation off %.2f %%, raw ADB %.3f, compensated ADB %.3f "
       "deg/h (%zu of %zu parks with the model valid)\n",

@@ -10,38 +10,38 @@
 #include <numbers>
 #include <string>
 
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
 
 #include "support/cpputest.hpp"
 
 namespace {
-using hrg::simtools::JobConfig;
-using hrg::simtools::JobResult;
+using hrg::sim_run::RunConfig;
+using hrg::sim_run::RunResult;
 
 constexpr double kRadSToDph = 180.0 / std::numbers::pi * 3600.0;
 
 // The default 365 s job with another resonator (ideal electrode, default ADC).
-JobConfig job_with(double q, double dmu, double split_hz) {
-  JobConfig j = hrg::simtools::default_job(0.0, 16);
+RunConfig job_with(double q, double dmu, double split_hz) {
+  RunConfig j = hrg::sim_run::default_run(0.0, 16);
   j.sim.resonator.q = q;
   j.sim.resonator.dmu = dmu;
   j.sim.resonator.split_hz = split_hz;
   j.firmware.chain.q_factor = q;
-  hrg::simtools::derive_firmware_config(j);
+  hrg::sim_run::derive_firmware_config(j);
   return j;
 }
 
 // The model's own uncertainty on the angle-dependent bias: the sigma of the
 // damping anisotropy terms as input rate (deg/h).
-double model_bias_sigma_dph(const JobResult& r, const JobConfig& j) {
+double model_bias_sigma_dph(const RunResult& r, const RunConfig& j) {
   return std::hypot(r.identification.sigma[1], r.identification.sigma[2]) /
          j.firmware.gyro.angular_gain * kRadSToDph;
 }
 
 void check_no_control_drift(double q, double dmu, double split_hz) {
-  const JobConfig j = job_with(q, dmu, split_hz);
-  const JobResult r = hrg::simtools::run_job(j, {});
+  const RunConfig j = job_with(q, dmu, split_hz);
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
   const double sigma_dph = model_bias_sigma_dph(r, j);
   CHECK(sigma_dph > 0.0);
   CHECK(std::fabs(r.control_drift_mean_dph) < sigma_dph);
@@ -58,8 +58,8 @@ void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
 TEST(BiasTestStart, ASlowConvergingResonatorIsReportedNotMeasuredWithTheLengthItNeeds) {
   // GIVEN the relaxed resonator (Q 1e6, dmu 0.15, split 5e-3 Hz), whose
   // identification ends well after the sweep (the parks start at ~110 s)
-  JobConfig j = job_with(1.0e6, 0.15, 5.0e-3);
-  JobResult r = hrg::simtools::run_job(j, {});
+  RunConfig j = job_with(1.0e6, 0.15, 5.0e-3);
+  RunResult r = hrg::sim_run::run_simulation(j, {});
   // THEN the parks before the model was valid are not in the compensated fit
   CHECK(r.t_model_valid_s > j.parks.front().t_begin_s);
   CHECK(r.parks_model_valid < r.parks.size());
@@ -70,7 +70,7 @@ TEST(BiasTestStart, ASlowConvergingResonatorIsReportedNotMeasuredWithTheLengthIt
   // a length at least the wait longer.
   CHECK(r.parks_model_valid >= 4 || !r.fit_comp.ok);
   CHECK(r.bias_test_needs_s >= j.duration_s + r.t_model_valid_s - j.parks.front().t_begin_s - 1);
-  CHECK_FALSE(hrg::simtools::judge(j, r));
+  CHECK_FALSE(hrg::sim_run::judge(j, r));
   bool named = false;
   for (const auto& f : r.failures)
     named = named || f.find("needs a run of at least") != std::string::npos;
@@ -81,11 +81,11 @@ TEST(BiasTestStart, ASlowConvergingResonatorIsReportedNotMeasuredWithTheLengthIt
 }
 
 TEST(BiasTestStart, TheDefaultRunsParksAreMostlyMeasuredWithTheModelValid) {
-  JobConfig j = hrg::simtools::default_job(0.0, 16);
-  JobResult r = hrg::simtools::run_job(j, {});
+  RunConfig j = hrg::sim_run::default_run(0.0, 16);
+  RunResult r = hrg::sim_run::run_simulation(j, {});
   CHECK(r.parks_model_valid >= 12);
   CHECK(r.fit_comp.ok);
-  CHECK(hrg::simtools::judge(j, r));
+  CHECK(hrg::sim_run::judge(j, r));
 }
 
 TEST_GROUP(ControlDriftGate){

@@ -8,8 +8,8 @@
 
 #include "audit/audit.hpp"
 #include "recording/recording.hpp"
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -25,7 +25,7 @@ void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
 namespace {
 
 // A free-decay window during which the table rate changes by > 1 deg/s.
-bool has_free_decay_under_acceleration(const hrg::simtools::JobResult& r) {
+bool has_free_decay_under_acceleration(const hrg::sim_run::RunResult& r) {
   double rate_at_start_dps = 0.0;
   bool in_window = false;
   for (const auto& row : r.rows) {
@@ -41,10 +41,10 @@ bool has_free_decay_under_acceleration(const hrg::simtools::JobResult& r) {
 TEST(SimTelemetryAudit, TheBaselineFitsTheFreeDecaysToTheNoiseLevel) {
   // GIVEN 200 s of the default job: ring-up, the rate-table sweep with its
   // 1 s free-decay windows, and parks; the PLL moves the demodulator's NCO.
-  const hrg::simtools::JobConfig j = hrg::simtools::default_job(200.0, 8);
-  const hrg::simtools::JobResult r = hrg::simtools::run_job(j, {});
+  const hrg::sim_run::RunConfig j = hrg::sim_run::default_run(200.0, 8);
+  const hrg::sim_run::RunResult r = hrg::sim_run::run_simulation(j, {});
   const auto path = std::filesystem::temp_directory_path() / "hrg_test_e2e_audit.csv";
-  hrg::simtools::write_telemetry(path, j, r);
+  hrg::sim_run::write_telemetry(path, j, r);
   const hrg::recording::Recording rec = hrg::recording::read_recording(path);
   std::filesystem::remove(path);
   // WHEN it is audited

@@ -8,9 +8,9 @@
 #include <numbers>
 #include <string>
 
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
-#include "sim_tools/scenario_job.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
+#include "sim_run/scenario_run.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -27,28 +27,28 @@ namespace {
 
 using hrg::fw::app::CalibrationSource;
 using hrg::fw::app::CalibrationVerdict;
-using hrg::simtools::JobConfig;
-using hrg::simtools::JobResult;
+using hrg::sim_run::RunConfig;
+using hrg::sim_run::RunResult;
 
-JobConfig default_scenario() {
+RunConfig default_scenario() {
   const char* src = std::getenv("HRG_SOURCE_DIR");
   const std::string dir = src ? src : ".";
-  return hrg::simtools::job_from_scenario(dir + "/sim_target/scenarios/default.toml", {});
+  return hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", {});
 }
 
-JobConfig with_gain_mismatch(double gain) {
-  JobConfig j = default_scenario();
+RunConfig with_gain_mismatch(double gain) {
+  RunConfig j = default_scenario();
   j.sim.effects.pickoff_gain_mismatch.enabled = true;
   j.sim.effects.pickoff_gain_mismatch.gain = gain;
   return j;
 }
 
-JobResult run_scenario(const JobConfig& j) { return hrg::simtools::run_job(j, {}); }
+RunResult run_scenario(const RunConfig& j) { return hrg::sim_run::run_simulation(j, {}); }
 
 // End of the first free-decay window that starts after the campaign ended:
 // the first row out of free_decay after one in it (the firmware's clock; the
 // exc column still shows the demodulator's averaging span).
-double first_check_end_s(const JobResult& r) {
+double first_check_end_s(const RunResult& r) {
   const int free_decay = static_cast<int>(hrg::fw::Mode::free_decay);
   bool in_window = false;
   for (const auto& row : r.rows) {
@@ -59,13 +59,13 @@ double first_check_end_s(const JobResult& r) {
   return -1.0;
 }
 
-bool any_valid_before(const JobResult& r, double t_s) {
+bool any_valid_before(const RunResult& r, double t_s) {
   for (const auto& row : r.rows)
     if (row.t_s < t_s && row.comp_valid == 1) return true;
   return false;
 }
 
-bool failure_mentions(const JobResult& r, const char* text) {
+bool failure_mentions(const RunResult& r, const char* text) {
   for (const auto& f : r.failures)
     if (f.find(text) != std::string::npos) return true;
   return false;
@@ -75,7 +75,7 @@ bool failure_mentions(const JobResult& r, const char* text) {
 
 TEST(CalibrationLoop, TheCompensationIsNotValidBetweenTheCampaignAndTheFirstCheck) {
   // GIVEN the clean gyro
-  const JobResult r = run_scenario(default_scenario());
+  const RunResult r = run_scenario(default_scenario());
   // THEN the campaign ended, a check window followed, and comp_valid was 0
   // in every row until that window had ended; 1 at the end of the run.
   CHECK(r.t_converged_s > 0.0);
@@ -91,10 +91,10 @@ TEST(CalibrationLoop, TheCompensationIsNotValidBetweenTheCampaignAndTheFirstChec
 TEST(CalibrationLoop, AGainOfTheWrongSignIsWithdrawnAndReported) {
   // GIVEN a 1 % y gain mismatch and a calibration file with its sign wrong
   // (the chain then sees a 2 % mismatch: 4theta level ripple of 2 %)
-  JobConfig j = with_gain_mismatch(0.01);
+  RunConfig j = with_gain_mismatch(0.01);
   j.firmware.calibration.pickoff_y_gain = -0.01;
-  JobResult r = run_scenario(j);
-  (void)hrg::simtools::judge(j, r);
+  RunResult r = run_scenario(j);
+  (void)hrg::sim_run::judge(j, r);
   // THEN the first check window after the campaign disagrees beyond the
   // noise, the calibration is withdrawn and said so, and no row ever
   // reported the compensation valid.
@@ -110,10 +110,10 @@ TEST(CalibrationLoop, AGainOfTheWrongSignIsWithdrawnAndReported) {
 
 TEST(CalibrationLoop, TheRightGainIsConfirmedAndGivesTheCleanBias) {
   // GIVEN the same gyro with the true gain in the file
-  JobConfig j = with_gain_mismatch(0.01);
+  RunConfig j = with_gain_mismatch(0.01);
   j.firmware.calibration.pickoff_y_gain = 0.01;
-  const JobResult r = run_scenario(j);
-  const JobResult clean = run_scenario(default_scenario());
+  const RunResult r = run_scenario(j);
+  const RunResult clean = run_scenario(default_scenario());
   // THEN the first check confirms it (misfit at the noise level), and the
   // compensated angle-dependent bias is the clean gyro's to within 10 %
   // (the correction is exact: what is left is the clean run's).
@@ -130,7 +130,7 @@ namespace {
 // The truth must lie within 5 sigma of what the firmware put in force: with
 // the last solve's residual when it was accepted (its sigma), else the last
 // applied estimate's sigma (the residual was removed with it).
-void check_in_force(const JobResult& r, double true_gain, double true_misalignment_rad) {
+void check_in_force(const RunResult& r, double true_gain, double true_misalignment_rad) {
   const hrg::est::PickoffSelfCalResult& last = r.self_calibration;
   const hrg::est::PickoffSelfCalResult& applied = r.self_calibration_applied.applied;
   const bool last_ok = last.status == hrg::est::Status::ok;
@@ -144,11 +144,11 @@ void check_in_force(const JobResult& r, double true_gain, double true_misalignme
 }
 
 // Do no harm: a compensation reported valid is never worse than raw.
-void check_no_harm(const JobResult& r) {
+void check_no_harm(const RunResult& r) {
   if (r.compensation_valid) CHECK(r.fit_comp.amplitude() <= r.fit_raw.amplitude());
 }
 
-JobConfig self_calibrating(JobConfig j) {
+RunConfig self_calibrating(RunConfig j) {
   j.firmware.online_pickoff_calibration = true;
   return j;
 }
@@ -157,7 +157,7 @@ JobConfig self_calibrating(JobConfig j) {
 
 TEST(CalibrationLoop, OnTheCleanGyroTheSelfCalibrationAppliesNothing) {
   // GIVEN the clean gyro, no file, the online self-calibration on
-  const JobResult r = run_scenario(self_calibrating(default_scenario()));
+  const RunResult r = run_scenario(self_calibrating(default_scenario()));
   // THEN its solve is accepted (the sweep's turning windows and the still
   // check windows separate g and b from the damping) and finds nothing
   // significant: nothing is applied, the run is the clean one.
@@ -172,7 +172,7 @@ TEST(CalibrationLoop, OnTheCleanGyroTheSelfCalibrationAppliesNothing) {
 
 TEST(CalibrationLoop, AGainMismatchIsFoundAndCorrectedOnline) {
   // GIVEN a 1 % y gain mismatch and no calibration file
-  const JobResult r = run_scenario(self_calibrating(with_gain_mismatch(0.01)));
+  const RunResult r = run_scenario(self_calibrating(with_gain_mismatch(0.01)));
   // THEN the firmware applies its own estimate (the first-order estimate,
   // then its O(g^2) residual), and what is in force is the truth to within
   // the identification's 5 sigma; the identification starts again on the
@@ -186,10 +186,10 @@ TEST(CalibrationLoop, AGainMismatchIsFoundAndCorrectedOnline) {
 
 TEST(CalibrationLoop, AMisalignmentIsFoundAndCorrectedOnline) {
   // GIVEN a 0.5 deg misalignment of the y pickoff and no calibration file
-  JobConfig j = default_scenario();
+  RunConfig j = default_scenario();
   j.sim.effects.pickoff_misalignment.enabled = true;
   j.sim.effects.pickoff_misalignment.angle_deg = 0.5;
-  const JobResult r = run_scenario(self_calibrating(j));
+  const RunResult r = run_scenario(self_calibrating(j));
   CHECK(r.self_calibration_applied.rounds >= 1);
   CHECK(r.calibration.source == CalibrationSource::online);
   check_in_force(r, 0.0, 0.5 * std::numbers::pi / 180.0);

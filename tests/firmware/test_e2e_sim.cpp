@@ -7,28 +7,28 @@
 #include <vector>
 
 #include "recording/recording.hpp"
-#include "sim_tools/job.hpp"
-#include "sim_tools/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/report.hpp"
 
 #include "support/cpputest.hpp"
 
-using hrg::simtools::JobConfig;
-using hrg::simtools::JobResult;
+using hrg::sim_run::RunConfig;
+using hrg::sim_run::RunResult;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
 
 // One run shared by the tests of the group (it takes a few seconds).
-const JobConfig& job() {
+const RunConfig& job() {
   // 200 s: ring-up, sweep and 8 parks, without the default run's final still hold.
-  static const JobConfig j = hrg::simtools::default_job(200.0, 8);
+  static const RunConfig j = hrg::sim_run::default_run(200.0, 8);
   return j;
 }
-const JobResult& result() {
-  static const JobResult r = [] {
-    JobResult x = hrg::simtools::run_job(job(), {});
-    hrg::simtools::judge(job(), x);
+const RunResult& result() {
+  static const RunResult r = [] {
+    RunResult x = hrg::sim_run::run_simulation(job(), {});
+    hrg::sim_run::judge(job(), x);
     return x;
   }();
   return r;
@@ -155,14 +155,14 @@ TEST(EndToEnd, TheExecutiveRanEveryFrameWithoutMisses) {
 }
 
 namespace {
-const JobConfig& static_job() {
-  static const JobConfig j = hrg::simtools::static_base_job(0.0);
+const RunConfig& static_job() {
+  static const RunConfig j = hrg::sim_run::static_base_run(0.0);
   return j;
 }
-const JobResult& static_result() {
-  static const JobResult r = [] {
-    JobResult x = hrg::simtools::run_job(static_job(), {});
-    hrg::simtools::judge(static_job(), x);
+const RunResult& static_result() {
+  static const RunResult r = [] {
+    RunResult x = hrg::sim_run::run_simulation(static_job(), {});
+    hrg::sim_run::judge(static_job(), x);
     return x;
   }();
   return r;
@@ -227,8 +227,8 @@ TEST(StaticBase, AfterTheCampaignTheCompensatedOutputHoldsStill) {
   }
   CHECK(t.size() > 1000);
   model /= static_cast<double>(t.size());
-  const double raw_dph = hrg::simtools::slope(t, raw) * 3600.0;
-  const double comp_dph = hrg::simtools::slope(t, comp) * 3600.0;
+  const double raw_dph = hrg::sim_run::slope(t, raw) * 3600.0;
+  const double comp_dph = hrg::sim_run::slope(t, comp) * 3600.0;
   CHECK(std::fabs(model) > 10.0);  // the parked angle has a large drift
   DOUBLES_EQUAL(model, raw_dph, 0.05 * std::fabs(model) + 0.5);
   CHECK(std::fabs(comp_dph) < 2.0);
@@ -237,12 +237,12 @@ TEST(StaticBase, AfterTheCampaignTheCompensatedOutputHoldsStill) {
 namespace {
 // A rung-up gyro (1 V wave at t = 0) on a still table for 30 s with one
 // injected fault from 10 s to 10.5 s.
-JobResult run_with_fault(hrg::simtools::FaultEvent::Kind kind) {
-  JobConfig j = hrg::simtools::static_base_job(30.0);
+RunResult run_with_fault(hrg::sim_run::FaultEvent::Kind kind) {
+  RunConfig j = hrg::sim_run::static_base_run(30.0);
   j.firmware.gyro.identify = false;
   j.sim.initial.amplitude_v = 1.0;
   j.faults = {{10.0, kind, 1, true}, {10.5, kind, 1, false}};
-  JobResult r = hrg::simtools::run_job(j, {});
+  RunResult r = hrg::sim_run::run_simulation(j, {});
   return r;
 }
 }  // namespace
@@ -255,7 +255,7 @@ void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
 ;
 
 TEST(InjectedFaults, AStuckAdcChannelIsAFaultAndTheGyroRecoversAfterTheHoldTime) {
-  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::adc_stuck);
+  const RunResult r = run_with_fault(hrg::sim_run::FaultEvent::Kind::adc_stuck);
   CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::adc_stuck));
   // Detected after 10 stuck blocks (10 ms), no sooner than the injection.
   CHECK(r.t_first_fault_s >= 10.0);
@@ -273,7 +273,7 @@ TEST(InjectedFaults, AStuckAdcChannelIsAFaultAndTheGyroRecoversAfterTheHoldTime)
 }
 
 TEST(InjectedFaults, ASaturatedAdcChannelIsAFaultAndTheGyroRecovers) {
-  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::adc_saturated);
+  const RunResult r = run_with_fault(hrg::sim_run::FaultEvent::Kind::adc_saturated);
   CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::adc_saturation));
   CHECK(r.t_first_fault_s >= 10.0);
   CHECK(r.t_first_fault_s < 10.0 + 0.007);  // 5 saturated blocks
@@ -281,7 +281,7 @@ TEST(InjectedFaults, ASaturatedAdcChannelIsAFaultAndTheGyroRecovers) {
 }
 
 TEST(InjectedFaults, TheBoardFaultInputEndsInSafeWithTheDrivesOff) {
-  const JobResult r = run_with_fault(hrg::simtools::FaultEvent::Kind::fault_input);
+  const RunResult r = run_with_fault(hrg::sim_run::FaultEvent::Kind::fault_input);
   CHECK(r.faults_seen & hrg::fw::fault_bit(hrg::fw::Fault::external));
   CHECK(hrg::fw::Mode::safe == r.final_mode);  // only a command leaves safe
   CHECK(r.t_back_operate_s < 0);
@@ -291,11 +291,11 @@ TEST(InjectedFaults, TheBoardFaultInputEndsInSafeWithTheDrivesOff) {
 TEST(InjectedFaults, AfterBusOffTheFirmwareRestartsTheCanControllerByItself) {
   // GIVEN the simulated controller forced bus-off at 5 s (TX queue dropped,
   // every send refused) and nothing else restarting it.
-  JobConfig j = hrg::simtools::static_base_job(8.0);
+  RunConfig j = hrg::sim_run::static_base_run(8.0);
   j.firmware.gyro.identify = false;
   j.sim.initial.amplitude_v = 1.0;
-  j.faults = {{5.0, hrg::simtools::FaultEvent::Kind::can_bus_off, 0, true}};
-  const JobResult r = hrg::simtools::run_job(j, {});
+  j.faults = {{5.0, hrg::sim_run::FaultEvent::Kind::can_bus_off, 0, true}};
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
   // THEN the command task (100 Hz) restarts it after kCanRestartRuns runs
   // bus-off, once, and telemetry is on the bus again within that time plus
   // one frame; the gyro itself never left its modes for it.
@@ -310,14 +310,14 @@ TEST(InjectedFaults, AfterBusOffTheFirmwareRestartsTheCanControllerByItself) {
 namespace {
 // The default run with and without the control-loop drift D_Phi in the
 // output; `gap` adds the pump electrode's gap harmonics (eps_p, eps_q).
-JobResult run_control(bool compensate, bool gap) {
-  JobConfig j = hrg::simtools::default_job(0.0, 16);
+RunResult run_control(bool compensate, bool gap) {
+  RunConfig j = hrg::sim_run::default_run(0.0, 16);
   if (gap) {
     j.sim.electrodes.eps_p = 0.02;
     j.sim.electrodes.eps_q = 0.01;
   }
   j.firmware.gyro.compensate_control_drift = compensate;
-  return hrg::simtools::run_job(j, {});
+  return hrg::sim_run::run_simulation(j, {});
 }
 }  // namespace
 
@@ -332,8 +332,8 @@ TEST(ControlLoopDrift, WithAnIdealPumpAddingDPhiDoesNotMakeTheBiasWorse) {
   // GIVEN the default resonator and an ideal ring electrode: the control
   // loops do not turn the pattern, so D_Phi is zero up to its noise and the
   // residual mean bias is the parks' own noise (it scales with the ADC noise).
-  const JobResult off = run_control(false, false);
-  const JobResult on = run_control(true, false);
+  const RunResult off = run_control(false, false);
+  const RunResult on = run_control(true, false);
   CHECK(off.fit_comp.ok && on.fit_comp.ok);
   // THEN neither the ADB nor the mean bias moves by more than the mean's
   // standard error from the parks' scatter.
@@ -349,9 +349,9 @@ TEST(ControlLoopDrift, TheGapHarmonicsOfThePumpAreCompensated) {
   // pattern turns at D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th),
   // amplitude nu |eps|/2 / K of input rate, which the free-decay windows
   // (pump off) cannot see.
-  const JobResult off = run_control(false, true);
-  const JobResult on = run_control(true, true);
-  const JobConfig j = hrg::simtools::default_job(0.0, 16);
+  const RunResult off = run_control(false, true);
+  const RunResult on = run_control(true, true);
+  const RunConfig j = hrg::sim_run::default_run(0.0, 16);
   const double nu = j.sim.resonator.nu_per_s();
   const double expected_dph =
       nu * std::hypot(0.02, 0.01) / 2.0 / j.firmware.gyro.angular_gain * kRadSToDph;
@@ -374,9 +374,9 @@ void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
 TEST(Lockstep, RunsAreDeterministic) {
   // Same scenario, same seed: the same telemetry to the last bit, whatever
   // the host's timing (task times never feed back in lockstep).
-  JobConfig j = hrg::simtools::default_job(40.0, 4);
-  const JobResult a = hrg::simtools::run_job(j, {});
-  const JobResult b = hrg::simtools::run_job(j, {});
+  RunConfig j = hrg::sim_run::default_run(40.0, 4);
+  const RunResult a = hrg::sim_run::run_simulation(j, {});
+  const RunResult b = hrg::sim_run::run_simulation(j, {});
   LONGS_EQUAL(a.rows.size(), b.rows.size());
   for (std::size_t i = 0; i < a.rows.size(); ++i) {
     CHECK(a.rows[i].cx_v == b.rows[i].cx_v);
@@ -388,10 +388,10 @@ TEST(Lockstep, RunsAreDeterministic) {
 }
 
 TEST(Lockstep, TheTelemetryIsAnHrgRecordingV1ThatReadsBack) {
-  JobConfig j = hrg::simtools::default_job(20.0, 4);
-  const JobResult r = hrg::simtools::run_job(j, {});
+  RunConfig j = hrg::sim_run::default_run(20.0, 4);
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
   const auto path = std::filesystem::temp_directory_path() / "hrg_test_e2e_telemetry.csv";
-  hrg::simtools::write_telemetry(path, j, r);
+  hrg::sim_run::write_telemetry(path, j, r);
   const hrg::recording::Recording rec = hrg::recording::read_recording(path);
   std::filesystem::remove(path);
   LONGS_EQUAL(r.rows.size(), rec.rows());

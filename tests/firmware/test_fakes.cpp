@@ -82,12 +82,12 @@ TEST(FakeChain, RingsUpToTheSetPointWhileDrivenAndDecaysWhenNot) {
   hrg::fw::ChainRecord out;
   for (int i = 0; i < 100; ++i)
     c.process(adc, dac, cmd, out);
-  DOUBLES_EQUAL(0.5, out.wave.a_A, 1e-12);
+  DOUBLES_EQUAL(0.5, out.wave.a_A_v, 1e-12);
   LONGS_EQUAL(1000, dac[5]);
   cmd.pump_on = false;
   c.decay_per_block = 0.5;
   c.process(adc, dac, cmd, out);
-  DOUBLES_EQUAL(0.25, out.wave.a_A, 1e-12);
+  DOUBLES_EQUAL(0.25, out.wave.a_A_v, 1e-12);
 }
 
 TEST(FakeChain, MovesThePatternTowardsTheTarget) {

@@ -2,10 +2,10 @@
 # The README's dependency table, checked on the includes of SOURCE_DIR. Each
 # rule names a folder and the headers it may not include (our include roots:
 # dsp/ estimator/ hal/ hal/linux/ firmware/ sim_target/, the host-only
-# toml_text/, and the host tools' sim_tools/ audit/ recording/ can/). tools/
+# toml_text/, and the host tools' sim_run/ audit/ recording/ can/). tools/
 # and tests/ may include anything.
 # RULE=<name> checks one rule only (the fixtures' tests).
-set(_tools "sim_tools|audit|recording|can")
+set(_tools "sim_run|audit|recording|can")
 set(rules dsp estimator hal hal_interfaces firmware sim_target toml_text)
 set(dir_dsp dsp)
 set(bad_dsp "estimator|hal|firmware|sim_target|toml_text|${_tools}")

@@ -193,10 +193,10 @@ void chain_on_synthetic_blocks(Report& r) {
   }
   const ChainOutputs& o = chain.outputs();
   // a_A = sqrt(0.5^2 + 0.0625^2) FS = 0.5039 FS = 1.0078 V at 2 V full scale
-  r.figure("chain a_A (uV)", static_cast<int64_t>(o.wave.a_A * 1e6));
+  r.figure("chain a_A (uV)", static_cast<int64_t>(o.wave.a_A_v * 1e6));
   r.figure("chain PLL offset from 5 kHz (uHz)",
            static_cast<int64_t>((o.pll_freq_hz - 5000.0) * 1e6));
-  r.check(std::fabs(o.wave.a_A - 2.0 * std::sqrt(0.25 + 0.0625 * 0.0625)) < 1e-4,
+  r.check(std::fabs(o.wave.a_A_v - 2.0 * std::sqrt(0.25 + 0.0625 * 0.0625)) < 1e-4,
           "chain measures a_A");
   r.check(std::fabs(o.pll_freq_hz - 5000.0) < 1e-3, "chain PLL locks to the tone");
   chain.set_excitation(false);

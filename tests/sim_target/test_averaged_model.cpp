@@ -20,7 +20,7 @@ TEST(AveragedModel, FreeDecayRateFollowsDampingAnisotropyAtSeveralAngles) {
     m.set_standing_wave(1.0, theta);
     m.advance(10.0);
     const WaveState w = m.wave();
-    const double rate = -std::log(w.a_a_v) / 10.0;
+    const double rate = -std::log(w.a_A_v) / 10.0;
     const double expected = test::amplitude_decay_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-3 * expected);
   }
@@ -35,7 +35,7 @@ TEST(AveragedModel, QuadratureGrowsAtHalfSplitTimesSinFourTheta) {
     m.set_standing_wave(1.0, theta);
     m.advance(0.5);
     const WaveState w = m.wave();
-    const double rate = w.a_b_v / 0.5;  // a_B(0) = 0, a_A ~ 1
+    const double rate = w.a_B_v / 0.5;  // a_B(0) = 0, a_A ~ 1
     const double expected = test::quadrature_growth_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-2 * std::abs(expected));
   }
@@ -125,7 +125,7 @@ TEST(AveragedModel, NonlinearDampingScalesTheDecayWithEnergy) {
   AveragedModel m(p, {}, fx);
   m.set_standing_wave(2.0, 0.0);
   m.advance(0.01);
-  const double rate = -std::log(m.wave().a_a_v / 2.0) / 0.01;
+  const double rate = -std::log(m.wave().a_A_v / 2.0) / 0.01;
   DOUBLES_EQUAL(p.nu_per_s() * (1.0 + 0.1 * 4.0), rate, 1e-4 * rate);
 }
 

@@ -53,7 +53,7 @@ TEST(Resonator, FreeDecayRateFollowsDampingAnisotropyAtSeveralAngles) {
     // WHEN it rings down freely for 2 s
     ring(r, 2.0);
     // THEN a_A decays at nu (1 + dmu cos 4(theta - th_mu)) within 0.1 %
-    const double rate = -std::log(true_wave(r).a_a_v) / 2.0;
+    const double rate = -std::log(true_wave(r).a_A_v) / 2.0;
     const double expected = test::amplitude_decay_per_s(p, theta);
     DOUBLES_EQUAL(expected, rate, 1e-3 * expected);
   }
@@ -69,8 +69,8 @@ TEST(Resonator, QuadratureGrowsAtHalfSplitTimesSinFourTheta) {
     ring(r, 0.5);
     const WaveState w = true_wave(r);
     // a_B' = dw sin4(theta - th_w) a_A with dw = pi split (half split, rad/s)
-    const double expected = test::quadrature_growth_per_s(p, theta) * 0.5 * (1.0 + w.a_a_v) * 0.5;
-    DOUBLES_EQUAL(expected, w.a_b_v, 1e-2 * std::abs(expected));
+    const double expected = test::quadrature_growth_per_s(p, theta) * 0.5 * (1.0 + w.a_A_v) * 0.5;
+    DOUBLES_EQUAL(expected, w.a_B_v, 1e-2 * std::abs(expected));
   }
 }
 
@@ -128,7 +128,7 @@ TEST(Resonator, AgreesWithTheAveragedModelOverTenSecondsWithRotation) {
   const WaveState wr = true_wave(r);
   const WaveState wa = m.wave();
   DOUBLES_EQUAL(0.0, std::remainder(wr.theta_rad - wa.theta_rad, kPi / 2), 1e-5);
-  DOUBLES_EQUAL(wa.a_a_v, wr.a_a_v, 1e-6 * wa.a_a_v);
+  DOUBLES_EQUAL(wa.a_A_v, wr.a_A_v, 1e-6 * wa.a_A_v);
 }
 
 TEST(Resonator, AgreesWithTheAveragedModelUnderASineRateAndATemperatureRamp) {
@@ -173,7 +173,7 @@ TEST(Resonator, AgreesWithTheAveragedModelUnderASineRateAndATemperatureRamp) {
   DOUBLES_EQUAL(0.0, std::remainder(theta_sum / 20.0 - wa.theta_rad, kPi / 2), 2e-7);
   m.advance(9.5 * kDt);  // now at the same time as the full-rate model
   const WaveState wr = true_wave(r);
-  DOUBLES_EQUAL(m.wave().a_a_v, wr.a_a_v, 1e-6);
+  DOUBLES_EQUAL(m.wave().a_A_v, wr.a_A_v, 1e-6);
   const double w0 = p.omega_rad_s();
   cplx x;
   cplx y;

@@ -151,7 +151,7 @@ TEST(SimBoard, ForcerRingsTheResonatorUpAtTheForcerGain) {
       c.electrodes.forcer_gain_per_s2 / (2.0 * w) * std::sin(0.5 * w * h) / (0.5 * w * h);
   const double t_on = 1.0;
   const double expected = drive / nu * (1.0 - std::exp(-nu * t_on));
-  DOUBLES_EQUAL(expected, target().true_state().a_a_v, 2e-3 * expected);
+  DOUBLES_EQUAL(expected, target().true_state().a_A_v, 2e-3 * expected);
 }
 
 TEST(SimBoard, SameSeedGivesTheSameBitsAndAnotherSeedDoesNot) {

@@ -37,7 +37,7 @@ TEST(LongRun, FullRateAndAveragedAgreeOverSixHundredSecondsWithRotation) {
     const WaveState wa = m.wave();
     worst_angle =
         std::max(worst_angle, std::abs(std::remainder(wr.theta_rad - wa.theta_rad, kPi / 2)));
-    worst_amp = std::max(worst_amp, std::abs(wr.a_a_v / wa.a_a_v - 1.0));
+    worst_amp = std::max(worst_amp, std::abs(wr.a_A_v / wa.a_A_v - 1.0));
   }
   // THEN the angle agrees within 1e-4 rad and the amplitude within 1e-5 relative
   DOUBLES_EQUAL(0.0, worst_angle, 1e-4);

@@ -43,7 +43,7 @@ WaveState true_wave(const Resonator& r) {
   return wave_state(x, y);
 }
 
-double growth_rate(const Resonator& r, double t_s) { return std::log(true_wave(r).a_a_v) / t_s; }
+double growth_rate(const Resonator& r, double t_s) { return std::log(true_wave(r).a_A_v) / t_s; }
 
 }  // namespace
 
@@ -69,7 +69,7 @@ TEST(ParametricPump, AtThresholdTheAmplitudeNeitherGrowsNorDecays) {
   d.pump_phase_rad = kPi / 4;
   m.set_drive(d);
   m.advance(2.0);
-  DOUBLES_EQUAL(0.0, std::log(m.wave().a_a_v) / 2.0, 0.01 * p.nu_per_s());
+  DOUBLES_EQUAL(0.0, std::log(m.wave().a_A_v) / 2.0, 0.01 * p.nu_per_s());
 }
 
 TEST(ParametricPump, AboveThresholdTheWaveGrowsAtTheMathieuRate) {
@@ -91,13 +91,13 @@ TEST(ParametricPump, AboveThresholdTheWaveGrowsAtTheMathieuRate) {
   d.pump_phase_rad = kPi / 4;
   m.set_drive(d);
   m.advance(2.0);
-  DOUBLES_EQUAL(expected, std::log(m.wave().a_a_v) / 2.0, 0.01 * expected);
+  DOUBLES_EQUAL(expected, std::log(m.wave().a_A_v) / 2.0, 0.01 * expected);
   // At -pi/4 the same pump damps: sigma = -k V0^2 / (8 w) - nu.
   d.pump_phase_rad = -kPi / 4;
   m.set_standing_wave(1.0, 0.0);
   m.set_drive(d);
   m.advance(1.0);
-  DOUBLES_EQUAL(-expected - 2.0 * p.nu_per_s(), std::log(m.wave().a_a_v), 1e-3 * expected);
+  DOUBLES_EQUAL(-expected - 2.0 * p.nu_per_s(), std::log(m.wave().a_A_v), 1e-3 * expected);
 }
 
 TEST(ParametricPump, GivesNoPreferredAngleWithoutGapNonUniformity) {
@@ -112,8 +112,8 @@ TEST(ParametricPump, GivesNoPreferredAngleWithoutGapNonUniformity) {
     pump(r, v0, kPi / 4, 1.0);
     const WaveState s = true_wave(r);
     DOUBLES_EQUAL(0.0, std::remainder(s.theta_rad - theta, kPi / 2), 1e-9);
-    if (theta == 0.0) first = s.a_a_v;
-    DOUBLES_EQUAL(first, s.a_a_v, 1e-9);
+    if (theta == 0.0) first = s.a_A_v;
+    DOUBLES_EQUAL(first, s.a_A_v, 1e-9);
   }
 }
 
@@ -136,8 +136,8 @@ TEST(ParametricPump, GapNonUniformityMakesThePumpPreferAnAngle) {
   mx.advance(1.0);
   my.advance(1.0);
   const double nu = p.nu_per_s();
-  DOUBLES_EQUAL(nu * 0.05, std::log(mx.wave().a_a_v), 1e-3 * nu);
-  DOUBLES_EQUAL(-nu * 0.05, std::log(my.wave().a_a_v), 1e-3 * nu);
+  DOUBLES_EQUAL(nu * 0.05, std::log(mx.wave().a_A_v), 1e-3 * nu);
+  DOUBLES_EQUAL(-nu * 0.05, std::log(my.wave().a_A_v), 1e-3 * nu);
 }
 
 TEST_GROUP(ElectrostaticSpring){};
@@ -220,13 +220,13 @@ TEST(Effects, ThermalFrequencyAndDampingFollowTemperature) {
   m.advance(10.0);
   const double df = p.f_hz * -20e-6 * 5.0;  // -0.5 Hz
   DOUBLES_EQUAL(std::remainder(2 * kPi * df * 10.0, 2 * kPi), m.wave().phase_a_rad, 1e-9);
-  DOUBLES_EQUAL(-p.nu_per_s() * 1.05 * 10.0, std::log(m.wave().a_a_v), 1e-9);
+  DOUBLES_EQUAL(-p.nu_per_s() * 1.05 * 10.0, std::log(m.wave().a_A_v), 1e-9);
   Resonator r(p, {}, fx);
   r.set_temperature_profile(Profile::constant(p.temp_ref_c + 5.0));
   r.set_standing_wave(1.0, 0.0);
   for (int i = 0; i < 100000; ++i)
     r.step({}, kDt);
-  DOUBLES_EQUAL(-p.nu_per_s() * 1.05, std::log(true_wave(r).a_a_v), 1e-6 * p.nu_per_s());
+  DOUBLES_EQUAL(-p.nu_per_s() * 1.05, std::log(true_wave(r).a_A_v), 1e-6 * p.nu_per_s());
   DOUBLES_EQUAL(2 * kPi * (p.f_hz + df), r.omega_rad_s(), 1e-9);
 }
 
@@ -342,6 +342,6 @@ TEST(ParametricPump, FullRateAndAveragedAgreeWithGapNonUniformity) {
   const WaveState wr = true_wave(r);
   const WaveState wa = m.wave();
   DOUBLES_EQUAL(wa.theta_rad, wr.theta_rad, 1e-6);
-  DOUBLES_EQUAL(wa.a_a_v, wr.a_a_v, 1e-6);
-  DOUBLES_EQUAL(wa.a_b_v, wr.a_b_v, 1e-3 * std::abs(wa.a_b_v));
+  DOUBLES_EQUAL(wa.a_A_v, wr.a_A_v, 1e-6);
+  DOUBLES_EQUAL(wa.a_B_v, wr.a_B_v, 1e-3 * std::abs(wa.a_B_v));
 }

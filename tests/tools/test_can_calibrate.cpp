@@ -11,8 +11,8 @@
 #include "firmware/app/firmware.hpp"
 #include "firmware/calibration_file.hpp"
 #include "sim_target/control.hpp"
-#include "sim_tools/console.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/console.hpp"
+#include "sim_run/run.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -33,9 +33,9 @@ fw::can::CalSecret secret() {
 // through the target's receive queue, the firmware's replies come out of
 // what it sent, one base frame (1 ms) at a time.
 struct Bench final : can::CalBusIo {
-  simtools::JobConfig job = simtools::default_job(60.0);
+  sim_run::RunConfig job = sim_run::default_run(60.0);
   std::unique_ptr<sim::SimTarget> target = std::make_unique<sim::SimTarget>();
-  simtools::HostClock timer;
+  sim_run::HostClock timer;
   std::unique_ptr<fw::app::Firmware> firmware;
 
   Bench() {

@@ -5,13 +5,13 @@
 #include <string>
 #include <vector>
 
-#include "sim_tools/analysis.hpp"
-#include "sim_tools/json.hpp"
+#include "sim_run/analysis.hpp"
+#include "sim_run/json.hpp"
 
 #include "support/cpputest.hpp"
 
-using hrg::simtools::allan_deviation;
-using hrg::simtools::fit_bias_4theta;
+using hrg::sim_run::allan_deviation;
+using hrg::sim_run::fit_bias_4theta;
 
 TEST_GROUP(AllanDeviation){};
 
@@ -73,13 +73,13 @@ TEST_GROUP(Slope){};
 
 TEST(Slope, IsTheLeastSquaresSlope) {
   std::vector<double> t{0, 1, 2, 3}, y{1, 3, 5, 7};
-  DOUBLES_EQUAL(2.0, hrg::simtools::slope(t, y), 1e-12);
+  DOUBLES_EQUAL(2.0, hrg::sim_run::slope(t, y), 1e-12);
 }
 
 TEST_GROUP(JsonWriter){};
 
 TEST(JsonWriter, WritesNestedObjectsArraysAndNullForNonFinite) {
-  hrg::simtools::JsonWriter w;
+  hrg::sim_run::JsonWriter w;
   w.begin_object();
   w.number("a", 1.5);
   w.begin_object("b");

@@ -42,7 +42,7 @@
 #include "hal/linux/board_linux.hpp"
 #include "hal/linux/realtime.hpp"
 #include "sim_target/control.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
 using namespace hrg;
 namespace lb = hrg::hal::linux_board;
@@ -181,7 +181,7 @@ int main(int argc, char** argv) {
   Options o;
   if (!parse(argc, argv, o)) return usage();
 
-  simtools::JobConfig job = simtools::default_job(o.seconds > 3600 ? 3600 : o.seconds, 0);
+  sim_run::RunConfig job = sim_run::default_run(o.seconds > 3600 ? 3600 : o.seconds, 0);
   job.firmware.gyro.calibration_service.secret = o.cal_secret;
   if (!o.calibration.empty()) {
     try {

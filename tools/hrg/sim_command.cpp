@@ -12,11 +12,11 @@
 #include <string_view>
 
 #include "firmware/calibration_file.hpp"
-#include "sim_tools/console.hpp"
-#include "sim_tools/job.hpp"
-#include "sim_tools/profile_report.hpp"
-#include "sim_tools/report.hpp"
-#include "sim_tools/scenario_job.hpp"
+#include "sim_run/console.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/profile_report.hpp"
+#include "sim_run/report.hpp"
+#include "sim_run/scenario_run.hpp"
 
 namespace hrg::cli {
 
@@ -77,7 +77,7 @@ struct SimOptions {
   bool plots = true, quiet = false, real_time = false, static_base = false, profile = false;
   bool control_drift = true;
   bool self_calibrate = false;
-  simtools::TelemetryFileOptions telemetry;
+  sim_run::TelemetryFileOptions telemetry;
 };
 
 // Parses the command line into `o`. Returns -1 to go on, else the exit
@@ -157,9 +157,9 @@ int parse_options(std::span<char* const> args, SimOptions& o) {
 }
 
 // The job the options ask for (throws on a bad scenario).
-simtools::JobConfig make_job(const SimOptions& o) {
-  simtools::JobConfig job =
-      simtools::make_job(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
+sim_run::RunConfig make_run(const SimOptions& o) {
+  sim_run::RunConfig job =
+      sim_run::make_run(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
   job.firmware.gyro.compensate_control_drift = o.control_drift;
   job.firmware.online_pickoff_calibration = o.self_calibrate;
   if (!o.calibration.empty())
@@ -168,20 +168,20 @@ simtools::JobConfig make_job(const SimOptions& o) {
 }
 
 // report.json, telemetry.csv, bias.csv, allan.csv into `dir` (throws).
-void write_results(const std::filesystem::path& dir, const simtools::JobConfig& job,
-                   const simtools::JobResult& r, const SimOptions& o) {
-  std::ofstream(dir / "report.json") << simtools::report_json(job, r);
-  const auto files = simtools::write_telemetry(dir / "telemetry.csv", job, r, o.telemetry);
+void write_results(const std::filesystem::path& dir, const sim_run::RunConfig& job,
+                   const sim_run::RunResult& r, const SimOptions& o) {
+  std::ofstream(dir / "report.json") << sim_run::report_json(job, r);
+  const auto files = sim_run::write_telemetry(dir / "telemetry.csv", job, r, o.telemetry);
   if (!o.quiet && (o.telemetry.decimate > 1 || o.telemetry.rotate_s > 0.0) && !files.empty()) {
     const std::string rotation =
-        o.telemetry.rotate_s > 0.0 ? simtools::fmt(" of %.0f s each", o.telemetry.rotate_s) : "";
+        o.telemetry.rotate_s > 0.0 ? sim_run::fmt(" of %.0f s each", o.telemetry.rotate_s) : "";
     std::fprintf(stderr,
                  "hrg sim: telemetry: every %zu-th row (%.1f Hz) in %zu file(s)%s from %s\n",
                  o.telemetry.decimate, job.telemetry_hz / static_cast<double>(o.telemetry.decimate),
                  files.size(), rotation.c_str(), files.front().filename().string().c_str());
   }
-  simtools::write_bias_csv(dir / "bias.csv", r);
-  simtools::write_allan_csv(dir / "allan.csv", r);
+  sim_run::write_bias_csv(dir / "bias.csv", r);
+  sim_run::write_allan_csv(dir / "allan.csv", r);
 }
 
 void plot(const std::filesystem::path& dir, bool quiet) {
@@ -198,9 +198,9 @@ void plot(const std::filesystem::path& dir, bool quiet) {
 int sim_main(std::span<char* const> args) {
   SimOptions o;
   if (const int status = parse_options(args, o); status >= 0) return status;
-  simtools::JobConfig job;
+  sim_run::RunConfig job;
   try {
-    job = make_job(o);
+    job = make_run(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
@@ -217,27 +217,27 @@ int sim_main(std::span<char* const> args) {
     std::fprintf(stderr, "hrg sim: %s; %.0f simulated s -> %s\n", job.description.c_str(),
                  job.duration_s, o.out_dir.c_str());
   }
-  simtools::JobResult r;
+  sim_run::RunResult r;
   try {
-    simtools::RunOptions opt;
-    opt.progress = !o.quiet && simtools::stderr_is_terminal();
+    sim_run::RunOptions opt;
+    opt.progress = !o.quiet && sim_run::stderr_is_terminal();
     opt.can_log = o.can_log;
     opt.real_time = o.real_time;
     opt.profile = o.profile;
-    r = simtools::run_job(job, opt);
+    r = sim_run::run_simulation(job, opt);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: %s\n", e.what());
     return 2;
   }
-  const bool passed = simtools::judge(job, r);
+  const bool passed = sim_run::judge(job, r);
   try {
     write_results(dir, job, r, o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hrg sim: writing the results: %s\n", e.what());
     return 2;
   }
-  if (!o.quiet) simtools::print_summary(stdout, job, r);
-  if (o.profile) std::fputs(simtools::format_profile(r).c_str(), stdout);
+  if (!o.quiet) sim_run::print_summary(stdout, job, r);
+  if (o.profile) std::fputs(sim_run::format_profile(r).c_str(), stdout);
   if (o.plots) plot(dir, o.quiet);
   if (!o.quiet) std::fprintf(stderr, "hrg sim: results in %s\n", o.out_dir.c_str());
   return passed ? 0 : 1;

@@ -110,7 +110,7 @@ double quad_force_rate_v_s(double forcer_gain_per_s2, double w_rad_s, double u_q
 
 // Slow outputs, one set per block (control rate), SI units.
 struct ChainOutputs {
-  Quadratures<double> quad;     // cx, sx, cy, sy, volts of pickoff
+  Quadratures<double> quad_v;   // cx, sx, cy, sy, volts of pickoff
   WaveVariables<double> wave;   // E, Q, R, S (V^2), a_A, a_B (V), theta wrapped, phase
   double theta_A_rad = 0.0;     // unwrapped pattern angle
   double phase_err_rad = 0.0;   // PLL phase detector output (wave phase mod pi)

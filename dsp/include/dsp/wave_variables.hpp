@@ -50,12 +50,12 @@ struct Quadratures {
 template <typename T>
 struct WaveVariables {
   static_assert(std::is_floating_point_v<T>, "wave variables are float or double");
-  T E{0};            // a_A^2 + a_B^2 (pickoff units squared)
-  T Q{0};            // 2 a_A a_B (quadrature)
-  T R{0};            // (a_A^2 - a_B^2) cos 4theta_A
-  T S{0};            // (a_A^2 - a_B^2) sin 4theta_A
-  T a_A{0};          // working wave amplitude, >= 0
-  T a_B{0};          // quadrature wave amplitude, signed like Q
+  T E_v2{0};         // a_A^2 + a_B^2 (pickoff units squared)
+  T Q_v2{0};         // 2 a_A a_B (quadrature)
+  T R_v2{0};         // (a_A^2 - a_B^2) cos 4theta_A
+  T S_v2{0};         // (a_A^2 - a_B^2) sin 4theta_A
+  T a_A_v{0};        // working wave amplitude, >= 0
+  T a_B_v{0};        // quadrature wave amplitude, signed like Q
   T theta_A_rad{0};  // pattern angle (physical), wrapped to (-pi/4, pi/4]
   T phase_rad{0};    // phase error phi of wave A against the reference, (-pi/2, pi/2]
 };
@@ -69,17 +69,17 @@ WaveVariables<T> wave_variables(const Quadratures<T>& q) {
   WaveVariables<T> w;
   const T xx = q.cx * q.cx + q.sx * q.sx;
   const T yy = q.cy * q.cy + q.sy * q.sy;
-  w.E = xx + yy;
-  w.R = xx - yy;
-  w.S = T(2) * (q.cx * q.cy + q.sx * q.sy);
-  w.Q = T(2) * (q.cx * q.sy - q.cy * q.sx);
-  if (!(w.E > T(0))) return w;
+  w.E_v2 = xx + yy;
+  w.R_v2 = xx - yy;
+  w.S_v2 = T(2) * (q.cx * q.cy + q.sx * q.sy);
+  w.Q_v2 = T(2) * (q.cx * q.sy - q.cy * q.sx);
+  if (!(w.E_v2 > T(0))) return w;
   // a_A^2 - a_B^2 = sqrt(R^2 + S^2); a_B from Q keeps its sign and avoids the
   // cancellation of sqrt(E - N) when a_B << a_A.
-  const T n = std::hypot(w.R, w.S);
-  w.a_A = std::sqrt((w.E + n) / T(2));
-  w.a_B = w.a_A > T(0) ? w.Q / (T(2) * w.a_A) : T(0);
-  w.theta_A_rad = std::atan2(w.S, w.R) / T(4);
+  const T n = std::hypot(w.R_v2, w.S_v2);
+  w.a_A_v = std::sqrt((w.E_v2 + n) / T(2));
+  w.a_B_v = w.a_A_v > T(0) ? w.Q_v2 / (T(2) * w.a_A_v) : T(0);
+  w.theta_A_rad = std::atan2(w.S_v2, w.R_v2) / T(4);
   const T l = q.cx * q.cx + q.cy * q.cy - q.sx * q.sx - q.sy * q.sy;
   const T p = T(2) * (q.cx * q.sx + q.cy * q.sy);
   w.phase_rad = std::atan2(-p, l) / T(2);

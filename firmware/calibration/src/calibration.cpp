@@ -62,10 +62,10 @@ dsp::FeedthroughCoefficients<double> feedthrough_coefficients(const Calibration&
           c.feedthrough_y_im_v_per_v};
 }
 
-double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_a_v,
+double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_A_v,
                            double pump_amplitude_v, bool pump_on) {
   double df = f_ref_hz * 1e-6 * c.thermal_frequency_ppm_per_c * (temp_c - c.temperature_ref_c);
-  df += c.duffing_hz_per_v2 * a_a_v * a_a_v;
+  df += c.duffing_hz_per_v2 * a_A_v * a_A_v;
   if (pump_on) df += c.electrostatic_spring_hz_per_v2 * pump_amplitude_v * pump_amplitude_v;
   return df;
 }

@@ -7,7 +7,7 @@
 
 #include "dsp/chain.hpp"
 #include "dsp/fixed.hpp"
-#include "firmware/ports.hpp"
+#include "firmware/chain_and_identifier.hpp"
 
 namespace hrg::fw {
 

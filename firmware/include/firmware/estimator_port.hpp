@@ -3,7 +3,7 @@
 
 #include "estimator/estimator.hpp"
 #include "estimator/pickoff_self_calibration.hpp"
-#include "firmware/ports.hpp"
+#include "firmware/chain_and_identifier.hpp"
 
 namespace hrg::fw {
 

@@ -13,7 +13,7 @@
 #include "firmware/fault_monitor.hpp"
 #include "firmware/mode.hpp"
 #include "firmware/mode_machine.hpp"
-#include "firmware/ports.hpp"
+#include "firmware/chain_and_identifier.hpp"
 #include "firmware/window_scheduler.hpp"
 #include "hal/board.hpp"
 

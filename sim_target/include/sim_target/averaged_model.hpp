@@ -59,8 +59,8 @@ struct WaveState {
   double s_v2 = 0.0;
   double quad_v2 = 0.0;    // Q = 2 a_A a_B
   double theta_rad = 0.0;  // theta_A = atan2(S, R) / 4 (physical)
-  double a_a_v = 0.0;
-  double a_b_v = 0.0;        // signed like Q
+  double a_A_v = 0.0;
+  double a_B_v = 0.0;        // signed like Q
   double phase_a_rad = 0.0;  // temporal phase phi_A of the A wave
 };
 
@@ -86,7 +86,7 @@ WaveState wave_state(cplx x_env, cplx y_env);
 
 // Envelopes of a standing wave: Z = e^{i phase}(a_A [cos2th, sin2th] - i a_B [-sin2th, cos2th]),
 // so that Q = 2 a_A a_B.
-void standing_wave(double a_a_v, double theta_rad, double a_b_v, double phase_rad, cplx& x_env,
+void standing_wave(double a_A_v, double theta_rad, double a_B_v, double phase_rad, cplx& x_env,
                    cplx& y_env);
 
 // Measurement side of the catalogue (gain/phase mismatch, misalignment, drive
@@ -111,7 +111,7 @@ class AveragedModel {
   void set_time(double t_s) { t_s_ = t_s; }
 
   // State. Envelopes are relative to the model's reference e^{i w_ref t}.
-  void set_standing_wave(double a_a_v, double theta_rad, double a_b_v = 0.0,
+  void set_standing_wave(double a_A_v, double theta_rad, double a_B_v = 0.0,
                          double phase_rad = 0.0);
   void set_envelopes(cplx x_env, cplx y_env);
 

@@ -32,8 +32,8 @@ struct TrueState {
   double pattern_angle_rad = 0.0;  // theta_A, unwrapped since configure()
   double input_angle_rad = 0.0;    // integral of Omega since configure()
   double energy_v2 = 0.0;          // E = a_A^2 + a_B^2
-  double a_a_v = 0.0;
-  double a_b_v = 0.0;
+  double a_A_v = 0.0;
+  double a_B_v = 0.0;
   double rate_rad_s = 0.0;
   double temp_c = 0.0;
   bool excitation_enabled = false;

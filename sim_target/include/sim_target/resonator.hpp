@@ -80,7 +80,7 @@ class Resonator {
   // x = Re(X e^{i w t}), y = Re(Y e^{i w t}) with w the present mean frequency,
   // velocities to match: a free state that starts the given envelopes now.
   void set_envelopes(std::complex<double> x_env, std::complex<double> y_env);
-  void set_standing_wave(double a_a_v, double theta_rad, double a_b_v = 0.0,
+  void set_standing_wave(double a_A_v, double theta_rad, double a_B_v = 0.0,
                          double phase_rad = 0.0);
   void set_state(double x_v, double y_v, double vx_v_per_s, double vy_v_per_s);
 

@@ -161,7 +161,7 @@ recording::Recording simulate_averaged(const Scenario& s) {
       sim::EnvelopeDrive drive;
       if (seg.excitation) {
         const auto wv = m.wave();
-        const double a = std::max(wv.a_a_v, 1e-6);
+        const double a = std::max(wv.a_A_v, 1e-6);
         // Amplitude: parametric pump at the best phase, growth rate set by a
         // proportional loop around the damping.
         const double growth = std::max(0.0, nu + 2.0 * (s.amplitude_v - a) / s.amplitude_v);
@@ -178,7 +178,7 @@ recording::Recording simulate_averaged(const Scenario& s) {
           const double err = std::remainder(target - wv.theta_rad, kPi / 2.0);
           theta_rate = std::clamp(6.0 * err, -0.5, 0.5);
         }
-        const sim::cplx u_perp = 2.0 * a * theta_rate + kI * 5.0 * wv.a_b_v;
+        const sim::cplx u_perp = 2.0 * a * theta_rate + kI * 5.0 * wv.a_B_v;
         drive.forcer_x_v = kI * 2.0 * w * (u_perp * (-s2)) / gf;
         drive.forcer_y_v = kI * 2.0 * w * (u_perp * c2) / gf;
         drive.forcers_follow_wave = true;

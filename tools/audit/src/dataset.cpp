@@ -101,7 +101,7 @@ void wave_rows(Rows& r) {
   for (std::size_t i = 0; i < r.n; ++i) {
     const auto w = dsp::wave_variables<double>({r.cx[i], r.sx[i], r.cy[i], r.sy[i]});
     r.theta[i] = unwrap.update(w.theta_A_rad);
-    r.a2[i] = w.a_A * w.a_A;
+    r.a2[i] = w.a_A_v * w.a_A_v;
     r.phase[i] = w.phase_rad;
     if (i > 0 && !r.gap_before[i]) {
       // The wave phase is defined modulo pi: keep it continuous.
@@ -215,7 +215,7 @@ std::pair<std::size_t, std::size_t> quiet_stretch(const Rows& r, const Run& run,
       const auto w = dsp::wave_variables<double>({r.cx[i], r.sx[i], r.cy[i], r.sy[i]});
       const double th_rate = (r.theta[i + h] - r.theta[i - h]) / (r.t[i + h] - r.t[i - h]);
       const double free_rate = -0.5 * d.angular_gain * r.rate_rad_s(i);
-      ok = std::abs(w.a_B) < 1e-3 * a + 3.0 * d.noise_v && std::abs(th_rate - free_rate) < 2e-3;
+      ok = std::abs(w.a_B_v) < 1e-3 * a + 3.0 * d.noise_v && std::abs(th_rate - free_rate) < 2e-3;
     }
     if (ok) {
       if (run_len == 0) run_first = i;

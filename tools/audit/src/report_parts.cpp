@@ -101,10 +101,10 @@ void fill_plot(const Dataset& d_, const EvalOptions& eo_, const Params& before, 
       plot.t_s.push_back(bl.t_s);
       plot.segment.push_back(static_cast<int>(si));
       plot.theta_deg.push_back(bl.theta_rad * kRadToDeg);
-      plot.a_meas.push_back(wm.a_A), plot.a_before.push_back(wb.a_A),
-          plot.a_after.push_back(wa.a_A);
-      plot.q_meas.push_back(wm.a_B), plot.q_before.push_back(wb.a_B),
-          plot.q_after.push_back(wa.a_B);
+      plot.a_meas.push_back(wm.a_A_v), plot.a_before.push_back(wb.a_A_v),
+          plot.a_after.push_back(wa.a_A_v);
+      plot.q_meas.push_back(wm.a_B_v), plot.q_before.push_back(wb.a_B_v),
+          plot.q_after.push_back(wa.a_B_v);
       auto rms4 = [&](const std::vector<double>& r) {
         return std::sqrt(
             (r[k] * r[k] + r[k + 1] * r[k + 1] + r[k + 2] * r[k + 2] + r[k + 3] * r[k + 3]) / 4.0);

@@ -372,8 +372,8 @@ void locate_harmonics(const Dataset& d, const Params& p, const std::vector<doubl
           dsp::wave_variables<double>({pr[0].real(), -pr[0].imag(), pr[1].real(), -pr[1].imag()});
       const double sig = d.noise_v / std::sqrt(bl.n);
       const double f[3] = {1.0, std::cos(4.0 * bl.theta_rad), std::sin(4.0 * bl.theta_rad)};
-      ha.add(f, (wm.a_A - wp.a_A) / sig);
-      hq.add(f, (wm.a_B - wp.a_B) / sig);
+      ha.add(f, (wm.a_A_v - wp.a_A_v) / sig);
+      hq.add(f, (wm.a_B_v - wp.a_B_v) / sig);
     }
   }
   const struct {

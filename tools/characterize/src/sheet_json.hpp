@@ -11,7 +11,7 @@
 
 #include "characterize/datasheet.hpp"
 #include "characterize/noise_terms.hpp"
-#include "sim_tools/json.hpp"
+#include "sim_run/json.hpp"
 
 namespace hrg::characterize::sheet {
 
@@ -24,7 +24,7 @@ inline std::string fmt(const char* f, double v) {
   return buf;
 }
 
-inline void numbers(simtools::JsonWriter& w, std::string_view key, const std::vector<double>& v) {
+inline void numbers(sim_run::JsonWriter& w, std::string_view key, const std::vector<double>& v) {
   w.begin_array(key);
   for (const double x : v)
     w.number(x);
@@ -33,7 +33,7 @@ inline void numbers(simtools::JsonWriter& w, std::string_view key, const std::ve
 
 using Series = SheetSeries;
 
-inline void plot(simtools::JsonWriter& w, std::string_view id, std::string_view title,
+inline void plot(sim_run::JsonWriter& w, std::string_view id, std::string_view title,
                  std::string_view x_label, std::string_view y_label, bool log_x, bool log_y,
                  const std::vector<Series>& series) {
   w.begin_object();
@@ -58,7 +58,7 @@ inline void plot(simtools::JsonWriter& w, std::string_view id, std::string_view 
   w.end_object();
 }
 
-inline void table(simtools::JsonWriter& w, std::string_view title,
+inline void table(sim_run::JsonWriter& w, std::string_view title,
                   const std::vector<std::string>& columns,
                   const std::vector<std::vector<std::string>>& rows) {
   w.begin_object();

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/analysis.hpp"
+#include "sim_run/analysis.hpp"
 
 #include <cmath>
 
 #include "characterize/allan.hpp"
 #include "characterize/harmonic_fit.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 std::vector<AllanPoint> allan_deviation(std::span<const double> angle, double tau0_s) {
   characterize::AllanOptions octaves;
@@ -54,4 +54,4 @@ double slope(std::span<const double> t, std::span<const double> y) {
   return stt > 0 ? sty / stt : 0.0;
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

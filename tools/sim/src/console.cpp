@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/console.hpp"
+#include "sim_run/console.hpp"
 
 #include <unistd.h>
 
@@ -7,7 +7,7 @@
 #include <cstdarg>
 #include <thread>
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 uint64_t HostClock::now_ns() const {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -77,4 +77,4 @@ std::string fmt(const char* format, ...) {
   return buf;
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/json.hpp"
+#include "sim_run/json.hpp"
 
 #include <cmath>
 #include <cstdio>
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 std::string JsonWriter::escape(std::string_view s) {
   std::string r;
@@ -98,4 +98,4 @@ void JsonWriter::boolean(std::string_view key, bool v) {
   out_ += v ? "true" : "false";
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

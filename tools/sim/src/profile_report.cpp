@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/profile_report.hpp"
+#include "sim_run/profile_report.hpp"
 
 #include <algorithm>
 #include <cstdio>
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 
@@ -19,7 +19,7 @@ void line(std::string& out, const char* what, double total_s, double frames, dou
 
 }  // namespace
 
-std::string format_profile(const JobResult& r) {
+std::string format_profile(const RunResult& r) {
   std::string out;
   char buf[320];
   std::snprintf(buf, sizeof buf,
@@ -64,4 +64,4 @@ std::string format_profile(const JobResult& r) {
   return out;
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

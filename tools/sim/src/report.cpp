@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/report.hpp"
+#include "sim_run/report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +9,10 @@
 #include <stdexcept>
 
 #include "recording/recording_writer.hpp"
-#include "sim_tools/console.hpp"
-#include "sim_tools/json.hpp"
+#include "sim_run/console.hpp"
+#include "sim_run/json.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
@@ -39,7 +39,7 @@ void bias_json(JsonWriter& w, const char* key, const BiasFit& f) {
 }
 }  // namespace
 
-std::string bias_test_coverage(const JobResult& r) {
+std::string bias_test_coverage(const RunResult& r) {
   std::string s =
       fmt("the compensated bias is measured on %zu of %zu parks (those with the model "
           "valid throughout",
@@ -52,7 +52,7 @@ std::string bias_test_coverage(const JobResult& r) {
   return s;
 }
 
-bool judge(const JobConfig& job, JobResult& r) {
+bool judge(const RunConfig& job, RunResult& r) {
   r.failures.clear();
   if (!r.reached_operate) r.failures.push_back("the gyro never reached operate");
   if (r.final_mode == fw::Mode::safe || r.final_mode == fw::Mode::fault) {
@@ -161,7 +161,7 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.end_object();
 }
 
-void drift_json(JsonWriter& w, const JobResult& r) {
+void drift_json(JsonWriter& w, const RunResult& r) {
   w.begin_object("drift");
   bias_json(w, "raw", r.fit_raw);
   bias_json(w, "compensated", r.fit_comp);
@@ -185,7 +185,7 @@ void drift_json(JsonWriter& w, const JobResult& r) {
   w.end_object();
 }
 
-void identification_json(JsonWriter& w, const JobResult& r) {
+void identification_json(JsonWriter& w, const RunResult& r) {
   w.begin_object("identification");
   w.boolean("accepted", r.identification.valid);
   w.number("condition_number", r.condition);
@@ -206,7 +206,7 @@ void identification_json(JsonWriter& w, const JobResult& r) {
   w.end_object();
 }
 
-void tracking_json(JsonWriter& w, const JobResult& r) {
+void tracking_json(JsonWriter& w, const RunResult& r) {
   w.begin_object("tracking");
   w.number("t_operate_s", r.t_operate_s);
   w.number("rms_deg", r.tracking_rms_deg);
@@ -218,7 +218,7 @@ void tracking_json(JsonWriter& w, const JobResult& r) {
   w.end_object();
 }
 
-void executive_json(JsonWriter& w, const JobResult& r) {
+void executive_json(JsonWriter& w, const RunResult& r) {
   w.begin_object("executive");
   w.string("pacing", r.real_time ? "real_time" : "lockstep");
   if (r.real_time) w.string("realtime_setup", r.realtime_setup);
@@ -241,7 +241,7 @@ void executive_json(JsonWriter& w, const JobResult& r) {
   w.end_object();
 }
 
-void allan_json(JsonWriter& w, const JobResult& r) {
+void allan_json(JsonWriter& w, const RunResult& r) {
   w.number("allan_span_s", r.allan_span_s);
   // The flat bottom of the curve (IEEE 952 bias instability, before the 0.664 factor).
   double adev_min = 0, tau_min = 0;
@@ -265,7 +265,7 @@ void allan_json(JsonWriter& w, const JobResult& r) {
 
 }  // namespace
 
-std::string report_json(const JobConfig& job, const JobResult& r) {
+std::string report_json(const RunConfig& job, const RunResult& r) {
   JsonWriter w;
   w.begin_object();
   w.string("scenario", job.description);
@@ -354,8 +354,8 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
        row.true_angle_deg,
        row.raw_angle_deg,
        row.true_theta_deg,
-       row.a_a_v,
-       row.a_b_v,
+       row.a_A_v,
+       row.a_B_v,
        row.drift_model_dph,
        row.drift_true_dph,
        double(row.out_valid),
@@ -365,7 +365,7 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
        row.out_error_deg};
 }
 
-std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobConfig& job) {
+std::vector<std::pair<std::string, std::string>> telemetry_metadata(const RunConfig& job) {
   return {{"source", "hrg sim (firmware + sim_target in lockstep)"},
           {"scenario", job.description},
           {"quad_v", "a_B, the quadrature wave amplitude"}};
@@ -374,7 +374,7 @@ std::vector<std::pair<std::string, std::string>> telemetry_metadata(const JobCon
 }  // namespace
 
 std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& path,
-                                                   const JobConfig& job, const JobResult& r,
+                                                   const RunConfig& job, const RunResult& r,
                                                    const TelemetryFileOptions& o) {
   // Streamed row by row: an hour of telemetry is not held twice in memory.
   std::vector<std::filesystem::path> files;
@@ -410,7 +410,7 @@ std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& 
   return files;
 }
 
-recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r) {
+recording::Recording telemetry_recording(const RunConfig& job, const RunResult& r) {
   recording::Recording rec(telemetry_columns(), job.firmware.chain.f_center_hz,
                            job.firmware.gyro.angular_gain);
   for (const auto& [key, value] : telemetry_metadata(job))
@@ -424,7 +424,7 @@ recording::Recording telemetry_recording(const JobConfig& job, const JobResult& 
   return rec;
 }
 
-void write_bias_csv(const std::filesystem::path& path, const JobResult& r) {
+void write_bias_csv(const std::filesystem::path& path, const RunResult& r) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write " + path.string());
   f << "theta_deg,raw_dph,compensated_dph,model_dph\n";
@@ -434,7 +434,7 @@ void write_bias_csv(const std::filesystem::path& path, const JobResult& r) {
   }
 }
 
-void write_allan_csv(const std::filesystem::path& path, const JobResult& r) {
+void write_allan_csv(const std::filesystem::path& path, const RunResult& r) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write " + path.string());
   f << "tau_s,adev_dph\n";
@@ -442,7 +442,7 @@ void write_allan_csv(const std::filesystem::path& path, const JobResult& r) {
     f << p.tau_s << ',' << p.adev * kRadSToDph << '\n';
 }
 
-void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
+void print_summary(std::FILE* out, const RunConfig& job, const RunResult& r) {
   TextTable run("run");
   run.row({"simulated", fmt("%.1f s", r.sim_s)});
   run.row({"wall", fmt("%.1f s", r.wall_s)});
@@ -519,4 +519,4 @@ void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r) {
   }
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -15,10 +15,10 @@
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/realtime.hpp"
 #include "sim_target/control.hpp"
-#include "sim_tools/console.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/console.hpp"
+#include "sim_run/run.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 
@@ -33,8 +33,8 @@ sim::TrueState midpoint(const sim::TrueState& a, const sim::TrueState& b) {
   m.pattern_angle_rad = 0.5 * (a.pattern_angle_rad + b.pattern_angle_rad);
   m.input_angle_rad = 0.5 * (a.input_angle_rad + b.input_angle_rad);
   m.energy_v2 = 0.5 * (a.energy_v2 + b.energy_v2);
-  m.a_a_v = 0.5 * (a.a_a_v + b.a_a_v);
-  m.a_b_v = 0.5 * (a.a_b_v + b.a_b_v);
+  m.a_A_v = 0.5 * (a.a_A_v + b.a_A_v);
+  m.a_B_v = 0.5 * (a.a_B_v + b.a_B_v);
   m.rate_rad_s = 0.5 * (a.rate_rad_s + b.rate_rad_s);
   m.temp_c = 0.5 * (a.temp_c + b.temp_c);
   return m;
@@ -53,8 +53,8 @@ struct Rig {
                       sim_board.fault_input, sim_board.can, rt_clock};
 };
 
-std::unique_ptr<fw::app::Firmware> build_firmware(const JobConfig& job, Rig& rig,
-                                                  const RunOptions& opt, JobResult& r) {
+std::unique_ptr<fw::app::Firmware> build_firmware(const RunConfig& job, Rig& rig,
+                                                  const RunOptions& opt, RunResult& r) {
   r.real_time = opt.real_time;
   if (opt.real_time) {
     hal::linux_board::RealtimeRequest req;
@@ -77,8 +77,8 @@ std::unique_ptr<fw::app::Firmware> build_firmware(const JobConfig& job, Rig& rig
 }
 
 // Applies the faults due by time t_s through the target's back door.
-void inject_faults(const JobConfig& job, double t_s, std::size_t& next, sim::SimTarget& target,
-                   JobResult& r) {
+void inject_faults(const RunConfig& job, double t_s, std::size_t& next, sim::SimTarget& target,
+                   RunResult& r) {
   while (next < job.faults.size() && job.faults[next].t_s <= t_s) {
     const FaultEvent& e = job.faults[next++];
     switch (e.kind) {
@@ -95,7 +95,7 @@ void inject_faults(const JobConfig& job, double t_s, std::size_t& next, sim::Sim
 }
 
 // Mode changes, faults, convergence and the CAN's return after a bus-off.
-void track_events(const fw::Gyro& gyro, sim::SimTarget& target, fw::Mode& last_mode, JobResult& r) {
+void track_events(const fw::Gyro& gyro, sim::SimTarget& target, fw::Mode& last_mode, RunResult& r) {
   const fw::GyroStatus& st = gyro.status();
   const double t_s = st.chain.t_s;
   if (st.mode != last_mode) {
@@ -130,7 +130,7 @@ struct LabTable {
 };
 
 // Counts (and logs, when asked) the frames the firmware put on the bus.
-void drain_can(sim::SimTarget& target, can::CandumpLogWriter* log, double t_s, JobResult& r) {
+void drain_can(sim::SimTarget& target, can::CandumpLogWriter* log, double t_s, RunResult& r) {
   auto& bus = target.can();
   if (log) {
     for (const auto& f : bus.sent())
@@ -153,7 +153,7 @@ class RowStamper {
   static constexpr std::size_t kCentre = dsp::kDecimatorOrder / 2;
   static constexpr std::size_t kHistory = kCentre + 2;
 
-  explicit RowStamper(const JobConfig& job) : f_ref_hz_(job.firmware.chain.f_center_hz) {
+  explicit RowStamper(const RunConfig& job) : f_ref_hz_(job.firmware.chain.f_center_hz) {
     // A row is free of any drive once the last driven DAC word (played
     // dac_lead_frames + the DAC's pipeline latency after its block) lies
     // before the N (L - 1) + 1 samples the demodulator averages.
@@ -217,7 +217,7 @@ struct AngleReference {
   double true_rad = 0.0, out_rad = 0.0, raw_rad = 0.0;
 };
 
-void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const RowStamper& stamp,
+void record_row(RunResult& r, const RunConfig& job, const fw::Gyro& g, const RowStamper& stamp,
                 const AngleReference& ref) {
   const fw::GyroStatus& st = g.status();
   const fw::ChainRecord& ch = st.chain;
@@ -231,28 +231,28 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const Row
   // e^(i ph)) with cx' - i sx' = (cx - i sx) e^(i (ph_nco - ph)).
   const double c = std::cos(stamp.ref_offset_rad());
   const double s = std::sin(stamp.ref_offset_rad());
-  row.cx_v = ch.quad.cx * c + ch.quad.sx * s;
-  row.sx_v = ch.quad.sx * c - ch.quad.cx * s;
-  row.cy_v = ch.quad.cy * c + ch.quad.sy * s;
-  row.sy_v = ch.quad.sy * c - ch.quad.cy * s;
+  row.cx_v = ch.quad_v.cx * c + ch.quad_v.sx * s;
+  row.sx_v = ch.quad_v.sx * c - ch.quad_v.cx * s;
+  row.cy_v = ch.quad_v.cy * c + ch.quad_v.sy * s;
+  row.sy_v = ch.quad_v.sy * c - ch.quad_v.cy * s;
   row.exc = stamp.drive_free() ? 0 : 1;
   row.excitation_cmd = st.excitation_on ? 1 : 0;
   row.pump_v = ch.pump_v;
   row.temp_c = ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;
   row.pll_hz = ch.pll_freq_hz;
-  row.quad_v = ch.wave.a_B;
+  row.quad_v = ch.wave.a_B_v;
   row.mode = static_cast<int>(st.mode);
   row.theta_deg = st.theta_unwrapped_rad / kDeg;
   row.out_angle_deg = (st.out_angle_rad - ref.out_rad) / kDeg;
   row.raw_angle_deg = (st.out_raw_angle_rad - ref.raw_rad) / kDeg;
   row.true_angle_deg = (ts.input_angle_rad - ref.true_rad) / kDeg;
   row.true_theta_deg = ts.pattern_angle_rad / kDeg;
-  row.a_a_v = ch.wave.a_A;
-  row.a_b_v = ch.wave.a_B;
+  row.a_A_v = ch.wave.a_A_v;
+  row.a_B_v = ch.wave.a_B_v;
   row.drift_model_dph = st.drift_rad_s / k * kRadSToDph;
   row.drift_control_dph = st.control_drift_rad_s / k * kRadSToDph;
-  const double q = ts.a_a_v > 0 ? ts.a_b_v / ts.a_a_v : 0.0;
+  const double q = ts.a_A_v > 0 ? ts.a_B_v / ts.a_A_v : 0.0;
   row.drift_true_dph =
       true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) / k * kRadSToDph;
   row.out_valid = st.out_valid ? 1 : 0;
@@ -261,7 +261,7 @@ void record_row(JobResult& r, const JobConfig& job, const fw::Gyro& g, const Row
   r.rows.push_back(row);
 }
 
-void summarise_executive(JobResult& r, const fw::Gyro& g) {
+void summarise_executive(RunResult& r, const fw::Gyro& g) {
   const auto& ex = g.executive();
   for (std::size_t i = 0; i < fw::Gyro::kTaskCount; ++i) {
     const auto& t = ex.task(i);
@@ -282,7 +282,7 @@ void summarise_executive(JobResult& r, const fw::Gyro& g) {
 }
 
 // What the firmware identified, against the truth and the Cramer-Rao bound.
-void summarise_identification(JobResult& r, const JobConfig& job,
+void summarise_identification(RunResult& r, const RunConfig& job,
                               const fw::app::Firmware& firmware) {
   const fw::Gyro& gyro = firmware.gyro();
   const fw::EstimatorPort& ident = firmware.estimator();
@@ -311,7 +311,7 @@ void summarise_identification(JobResult& r, const JobConfig& job,
 }
 
 // Speed of the run: wall and CPU time, the share spent in the simulation.
-void summarise_speed(JobResult& r, const fw::Gyro& gyro, uint64_t frames, double wall_s,
+void summarise_speed(RunResult& r, const fw::Gyro& gyro, uint64_t frames, double wall_s,
                      double cpu_s) {
   r.wall_s = wall_s;
   r.cpu_s = cpu_s;
@@ -324,8 +324,8 @@ void summarise_speed(JobResult& r, const fw::Gyro& gyro, uint64_t frames, double
 
 }  // namespace
 
-JobResult run_job(const JobConfig& job, const RunOptions& opt) {
-  JobResult r;
+RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
+  RunResult r;
   // A simulated target of its own: runs in parallel threads share nothing.
   const auto own_target = std::make_unique<sim::SimTarget>();
   sim::SimTarget& target = *own_target;
@@ -401,4 +401,4 @@ JobResult run_job(const JobConfig& job, const RunOptions& opt) {
   return r;
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

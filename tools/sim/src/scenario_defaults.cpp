@@ -4,10 +4,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "sim_tools/job.hpp"
-#include "sim_tools/table_schedule.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/table_schedule.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 
@@ -41,7 +41,7 @@ sim::SimConfig seed_target() {
 // information of a window grows as T^3).
 void identification_sweep(TableSchedule& sch, double k, bool long_run) {
   const double sweep_rate = 10.0 * kDeg;  // case rate, pattern at about 2.8 deg/s
-  const double sweep_case_rad = simtools::sweep_case_rad(k);
+  const double sweep_case_rad = sim_run::sweep_case_rad(k);
   sch.hold(kRingUpS);
   sch.turn(sweep_case_rad, sweep_rate, 1.0);
   if (long_run) {
@@ -59,7 +59,7 @@ void identification_sweep(TableSchedule& sch, double k, bool long_run) {
 // lengthens the holds; a shorter one drops the parks that do not fit. After
 // the parks the table stays still for a while: the longest still record, for
 // the Allan deviation (dropped first when the run is shortened).
-void parked_angles(TableSchedule& sch, JobConfig& j, double k, double duration_s, int bias_angles) {
+void parked_angles(TableSchedule& sch, RunConfig& j, double k, double duration_s, int bias_angles) {
   const double settle_s = 2.0;
   const double base_hold_s = 6.0;
   const double step_case_rad = (std::numbers::pi / 2.0) / bias_angles * 2.0 / k;
@@ -85,8 +85,8 @@ void parked_angles(TableSchedule& sch, JobConfig& j, double k, double duration_s
 
 }  // namespace
 
-JobConfig default_job(double duration_s, int bias_angles) {
-  JobConfig j;
+RunConfig default_run(double duration_s, int bias_angles) {
+  RunConfig j;
   j.description =
       "seed resonator (5 kHz, Q 5e6, dQ/Q 0.1, split 5e-4 Hz); Earth rate at 55.75 deg N; "
       "ring-up from rest, rate-table sweep, IEEE 1431 style parked-angle bias test";
@@ -113,8 +113,8 @@ JobConfig default_job(double duration_s, int bias_angles) {
   return j;
 }
 
-JobConfig static_base_job(double duration_s) {
-  JobConfig j = default_job(60.0, 4);
+RunConfig static_base_run(double duration_s) {
+  RunConfig j = default_run(60.0, 4);
   j.description =
       "seed resonator on a static base (Earth rate at 55.75 deg N only); the firmware turns "
       "the pattern on purpose to fill the 4 theta bins";
@@ -142,6 +142,6 @@ fw::ConverterLayout converter_layout(const sim::SimConfig& sim) {
   return conv;
 }
 
-void derive_firmware_config(JobConfig& j) { fw::app::derive(j.firmware, converter_layout(j.sim)); }
+void derive_firmware_config(RunConfig& j) { fw::app::derive(j.firmware, converter_layout(j.sim)); }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "sim_tools/json.hpp"
+#include "sim_run/json.hpp"
 
 namespace hrg::study {
 
@@ -30,14 +30,14 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
-void numbers(simtools::JsonWriter& w, const char* key, const std::vector<double>& v) {
+void numbers(sim_run::JsonWriter& w, const char* key, const std::vector<double>& v) {
   w.begin_array(key);
   for (const double x : v)
     w.number(or_none(x));
   w.end_array();
 }
 
-void seed_json(simtools::JsonWriter& w, const SeedResult& s) {
+void seed_json(sim_run::JsonWriter& w, const SeedResult& s) {
   w.begin_object();
   w.integer("seed", static_cast<long long>(s.seed));
   w.boolean("locked", s.locked);
@@ -55,7 +55,7 @@ void seed_json(simtools::JsonWriter& w, const SeedResult& s) {
   w.end_object();
 }
 
-void thresholds_json(simtools::JsonWriter& w, const char* key, const std::array<double, 3>& v) {
+void thresholds_json(sim_run::JsonWriter& w, const char* key, const std::array<double, 3>& v) {
   w.begin_object(key);
   const char* names[] = {"3", "0.1", "0.01"};
   for (std::size_t k = 0; k < v.size(); ++k)
@@ -66,7 +66,7 @@ void thresholds_json(simtools::JsonWriter& w, const char* key, const std::array<
 }  // namespace
 
 std::string point_json_line(const PointResult& p) {
-  simtools::JsonWriter w;
+  sim_run::JsonWriter w;
   w.begin_object();
   w.integer("point", static_cast<long long>(p.spec.index));
   w.number("split_hz", p.spec.split_hz);
@@ -144,7 +144,7 @@ std::vector<std::string> read_point_lines(const std::string& path, const Grid& g
 
 void write_study_json(const std::filesystem::path& dir, const Grid& grid,
                       const std::vector<std::string>& lines) {
-  simtools::JsonWriter head;
+  sim_run::JsonWriter head;
   head.begin_object();
   head.string("study", "tolerance");
   head.string("grid", grid.source);

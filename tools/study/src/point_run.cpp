@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "firmware/app/firmware.hpp"
-#include "sim_tools/job.hpp"
-#include "sim_tools/scenario_job.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/scenario_run.hpp"
 #include "study/point.hpp"
 
 namespace hrg::study {
@@ -20,10 +20,10 @@ constexpr double kRadSToDph = 180.0 / kPi * 3600.0;
 // keep a day's run in memory on every core and still resolve the parks.
 constexpr double kTelemetryHz = 10.0;
 
-// The main job's schedule (default_job) with the point's resonator and
+// The main job's schedule (default_run) with the point's resonator and
 // electrode gap; the default converters and ADC noise.
-simtools::JobConfig point_job(const Grid& grid, const PointSpec& spec, int seed_index) {
-  simtools::JobConfig j = simtools::default_job(grid.duration_s, grid.bias_angles);
+sim_run::RunConfig point_job(const Grid& grid, const PointSpec& spec, int seed_index) {
+  sim_run::RunConfig j = sim_run::default_run(grid.duration_s, grid.bias_angles);
   sim::ResonatorParams& r = j.sim.resonator;
   r.q = spec.q;
   r.dmu = 0.5 * spec.dq_over_q;  // dQ/Q ~ 2 dmu
@@ -34,7 +34,7 @@ simtools::JobConfig point_job(const Grid& grid, const PointSpec& spec, int seed_
   j.sim.seed = grid.base_seed + static_cast<uint64_t>(seed_index);
   j.telemetry_hz = kTelemetryHz;
   j.description = "study point " + std::to_string(spec.index);
-  simtools::adopt_resonator(j, j.description);
+  sim_run::adopt_resonator(j, j.description);
   return j;
 }
 
@@ -45,8 +45,8 @@ simtools::JobConfig point_job(const Grid& grid, const PointSpec& spec, int seed_
 // so D(pi/8) = dnu_C and D(0) = -dnu_S.
 class ConvergenceProbe {
  public:
-  ConvergenceProbe(const simtools::JobConfig& job, SeedResult& out)
-      : truth_(simtools::true_parameters(job.sim.resonator)),
+  ConvergenceProbe(const sim_run::RunConfig& job, SeedResult& out)
+      : truth_(sim_run::true_parameters(job.sim.resonator)),
         k_(job.firmware.gyro.angular_gain),
         out_(out) {}
 
@@ -69,7 +69,7 @@ class ConvergenceProbe {
   SeedResult& out_;
 };
 
-void copy_bias_test(const simtools::JobResult& r, const simtools::JobConfig& job, SeedResult& s) {
+void copy_bias_test(const sim_run::RunResult& r, const sim_run::RunConfig& job, SeedResult& s) {
   s.bias_fit = r.fit_comp.ok && r.fit_raw.ok;
   s.t_bias_start_s = job.parks.empty() ? -1.0 : job.parks.front().t_begin_s;
   s.raw_adb_dph = r.fit_raw.amplitude();
@@ -82,13 +82,13 @@ void copy_bias_test(const simtools::JobResult& r, const simtools::JobConfig& job
 }  // namespace
 
 SeedResult run_seed(const Grid& grid, const PointSpec& spec, int seed_index) {
-  const simtools::JobConfig job = point_job(grid, spec, seed_index);
+  const sim_run::RunConfig job = point_job(grid, spec, seed_index);
   SeedResult s;
   s.seed = job.sim.seed;
-  simtools::RunOptions opt;
+  sim_run::RunOptions opt;
   opt.observer = ConvergenceProbe(job, s);
   opt.observe_every_s = grid.sample_every_s;
-  const simtools::JobResult r = simtools::run_job(job, opt);
+  const sim_run::RunResult r = sim_run::run_simulation(job, opt);
   // The bound was taken at unit noise: scale by the run's per-sample noise.
   for (double& c : s.crb_adb_dph)
     if (c > 0.0) c *= r.noise_sigma_v;
@@ -106,7 +106,7 @@ PointResult prepare_point(const Grid& grid, const PointSpec& spec) {
   PointResult p;
   p.spec = spec;
   try {
-    const simtools::JobConfig job = point_job(grid, spec, 0);
+    const sim_run::RunConfig job = point_job(grid, spec, 0);
     const sim::ResonatorParams& r = job.sim.resonator;
     // The AGC holds a_A with the pump's growth rate k V0^2 / (8 w) equal to
     // the wave's decay rate, at most nu (1 + dmu) on the most damped axis.

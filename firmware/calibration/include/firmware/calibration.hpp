@@ -117,7 +117,7 @@ dsp::FeedthroughCoefficients<double> feedthrough_coefficients(const Calibration&
 // frequency offset from f_ref_hz (the frequency at T0, small amplitude, pump
 // off), Hz: f_ref alpha (T - T0) + c_duffing a_A^2 + c_spring V_pump^2 (pump on;
 // V_pump its amplitude).
-double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_a_v,
+double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_A_v,
                            double pump_amplitude_v, bool pump_on);
 // Factor on the whole damping (mean and anisotropy): (1 + beta (T - T0))(1 + eta E),
 // E = a_A^2 + a_B^2 (V^2 of pickoff).

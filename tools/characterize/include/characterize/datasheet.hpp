@@ -10,7 +10,7 @@
 #include "characterize/drift_series.hpp"
 #include "characterize/noise_terms.hpp"
 #include "characterize/scale_factor.hpp"
-#include "sim_tools/json.hpp"
+#include "sim_run/json.hpp"
 
 namespace hrg::characterize {
 
@@ -78,7 +78,7 @@ class DataSheet {
   void figure(std::string_view name, double value, double lo, double hi, double sigma,
               std::string_view unit, std::string_view note);
 
-  simtools::JsonWriter w_;
+  sim_run::JsonWriter w_;
 };
 
 }  // namespace hrg::characterize

@@ -10,12 +10,12 @@
 #include "characterize/drift_series.hpp"
 #include "characterize/noise_terms.hpp"
 #include "characterize/scale_factor.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
 namespace hrg::characterize {
 
 // The test procedures of IEEE Std 1431 / 952 run on the firmware and the
-// simulated target through the main job's runner (simtools::run_job): each
+// simulated target through the main job's runner (sim_run::run_simulation): each
 // procedure builds a rate-table (and temperature) schedule after the ring-up
 // and the identification sweep, runs it and reads its figures from the
 // telemetry rows, the way a test engineer reads them from a test record.
@@ -32,7 +32,7 @@ struct ProcedureOptions {
 // The procedure's job before its schedule: the scenario's (or the default)
 // target and firmware, ring-up and the identification sweep in `schedule`.
 struct ProcedureBase {
-  simtools::JobConfig job;
+  sim_run::RunConfig job;
   double earth_rad_s = 0.0;  // constant input besides the table (Earth rate)
 };
 ProcedureBase procedure_base(const ProcedureOptions& o);
@@ -50,8 +50,8 @@ ScaleFactorResult run_scale_factor(const ProcedureOptions& o);
 // --- drift rate series (IEEE 1431 12.11) ---
 struct DriftResult {
   // Angle-dependent bias of the main job's parked-angle test.
-  simtools::BiasFit adb_raw, adb_comp, adb_model;
-  std::vector<simtools::ParkResult> parks;
+  sim_run::BiasFit adb_raw, adb_comp, adb_model;
+  std::vector<sim_run::ParkResult> parks;
   double theta_at_sweep_end_deg = 0.0;  // the firmware's pattern angle after the sweep
   double pattern_per_case = 0.0;        // pattern angle per case angle (-K / 2), measured
   std::vector<double> turn_on_bias_dph;

@@ -6,7 +6,7 @@
 
 #include "batch/batch.hpp"
 #include "common.hpp"
-#include "sim_tools/scenario_job.hpp"
+#include "sim_run/scenario_run.hpp"
 
 namespace hrg::characterize {
 
@@ -16,8 +16,8 @@ using proc::kDeg;
 constexpr double kSettleS = 5.0;  // after the sweep, before the bias is read
 
 // Bias of the output (deg/h): the slope of output minus true angle.
-double bias_dph(const std::vector<simtools::TelemetryRow>& rows,
-                double simtools::TelemetryRow::*error, double t0_s, double t1_s) {
+double bias_dph(const std::vector<sim_run::TelemetryRow>& rows,
+                double sim_run::TelemetryRow::*error, double t0_s, double t1_s) {
   return proc::rate_of(rows, error, t0_s, t1_s) * 3600.0;
 }
 
@@ -26,7 +26,7 @@ double bias_dph(const std::vector<simtools::TelemetryRow>& rows,
 void turn_ons(const ProcedureOptions& o, const ProcedureBase& base, DriftResult& res) {
   const double hold_s = o.short_run ? 30.0 : 60.0;
   const auto n = static_cast<std::size_t>(o.turn_ons);
-  std::vector<simtools::JobConfig> jobs;
+  std::vector<sim_run::RunConfig> jobs;
   double t0 = 0.0, t1 = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     ProcedureBase b = base;
@@ -39,13 +39,12 @@ void turn_ons(const ProcedureOptions& o, const ProcedureBase& base, DriftResult&
   }
   ProcedureOptions one = o;
   one.progress = o.progress && (o.jobs == 1 || n <= 1);  // one bar at a time
-  const std::vector<simtools::JobResult> runs =
+  const std::vector<sim_run::RunResult> runs =
       batch::run_indexed(n, o.jobs, [&](std::size_t i) { return proc::run_alone(jobs[i], one); });
-  for (const simtools::JobResult& r : runs) {
+  for (const sim_run::RunResult& r : runs) {
     res.wall_s += r.wall_s;
     res.sim_s += r.sim_s;
-    res.turn_on_bias_dph.push_back(
-        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, t0, t1));
+    res.turn_on_bias_dph.push_back(bias_dph(r.rows, &sim_run::TelemetryRow::out_error_deg, t0, t1));
   }
   res.repeatability = bias_repeatability(res.turn_on_bias_dph);
 }
@@ -58,17 +57,17 @@ void temperature_ramp(const ProcedureOptions& o, const ProcedureBase& base, Drif
   proc::Schedule sch(base.job.firmware.gyro.angular_gain);
   const double t0 = sch.t() + kSettleS;
   sch.hold(kSettleS + hold_s);
-  simtools::JobConfig job = proc::scheduled_job(base, sch);
+  sim_run::RunConfig job = proc::scheduled_job(base, sch);
   if (job.sim.temp_c.is_constant()) {
     const double c0 = job.sim.temp_c.value(0.0);
     job.sim.temp_c = sim::Profile::ramps({{0.0, c0}, {t0, c0}, {sch.t(), c0 + 20.0}});
   }
-  const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
+  const sim_run::RunResult r = proc::run(job, o, res.wall_s, res.sim_s);
   double model_sum = 0.0, model_n = 0.0;
   for (int s = 0; s < kSegments; ++s) {
     const double a = t0 + hold_s * s / kSegments, b = t0 + hold_s * (s + 1) / kSegments;
     double temp_sum = 0.0, n = 0.0;
-    for (const simtools::TelemetryRow& row : r.rows) {
+    for (const sim_run::TelemetryRow& row : r.rows) {
       if (row.t_s < a || row.t_s > b) continue;
       temp_sum += row.temp_c;
       model_sum += row.drift_true_dph;
@@ -77,9 +76,9 @@ void temperature_ramp(const ProcedureOptions& o, const ProcedureBase& base, Drif
     }
     res.temperature_c.push_back(n > 0 ? temp_sum / n : 0.0);
     res.temperature_bias_dph.push_back(
-        bias_dph(r.rows, &simtools::TelemetryRow::out_error_deg, a, b));
+        bias_dph(r.rows, &sim_run::TelemetryRow::out_error_deg, a, b));
     res.temperature_raw_bias_dph.push_back(
-        bias_dph(r.rows, &simtools::TelemetryRow::raw_error_deg, a, b));
+        bias_dph(r.rows, &sim_run::TelemetryRow::raw_error_deg, a, b));
   }
   res.temperature_model_dph = model_n > 0 ? model_sum / model_n : 0.0;
   res.temperature = bias_temperature_slope(res.temperature_c, res.temperature_bias_dph);
@@ -90,16 +89,16 @@ void temperature_ramp(const ProcedureOptions& o, const ProcedureBase& base, Drif
 
 DriftResult run_angle_dependent_bias(const ProcedureOptions& o) {
   const int angles = o.short_run ? 8 : 16;
-  simtools::JobConfig job = simtools::make_job(o.scenario, {0.0, angles, false});
+  sim_run::RunConfig job = sim_run::make_run(o.scenario, {0.0, angles, false});
   DriftResult res;
-  const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
+  const sim_run::RunResult r = proc::run(job, o, res.wall_s, res.sim_s);
   res.adb_raw = r.fit_raw;
   res.adb_comp = r.fit_comp;
   res.adb_model = r.fit_model;
   res.parks = r.parks;
   // The pattern turns against the case at -K / 2: measured over the sweep.
-  const simtools::TelemetryRow& a = proc::row_at(r.rows, simtools::kRingUpS);
-  const simtools::TelemetryRow& b = proc::row_at(r.rows, job.sweep_end_s);
+  const sim_run::TelemetryRow& a = proc::row_at(r.rows, sim_run::kRingUpS);
+  const sim_run::TelemetryRow& b = proc::row_at(r.rows, job.sweep_end_s);
   res.theta_at_sweep_end_deg = b.theta_deg;
   res.pattern_per_case = (b.theta_deg - a.theta_deg) / (b.true_angle_deg - a.true_angle_deg);
   return res;

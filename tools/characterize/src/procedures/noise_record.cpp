@@ -14,11 +14,11 @@ NoiseResult run_noise(const ProcedureOptions& o) {
   sch.hold(5.0);
   const double t0 = sch.t();
   sch.hold(record_s);
-  const simtools::JobConfig job = proc::scheduled_job(base, sch);
+  const sim_run::RunConfig job = proc::scheduled_job(base, sch);
   NoiseResult res;
-  const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
+  const sim_run::RunResult r = proc::run(job, o, res.wall_s, res.sim_s);
   std::vector<double> angle_rad;
-  for (const simtools::TelemetryRow& row : r.rows) {
+  for (const sim_run::TelemetryRow& row : r.rows) {
     if (row.t_s < t0) continue;
     if (!row.out_valid) break;  // one contiguous stretch
     angle_rad.push_back(row.out_error_deg * proc::kDeg);

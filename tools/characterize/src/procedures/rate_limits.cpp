@@ -19,7 +19,7 @@ constexpr double kPi = std::numbers::pi;
 
 // Zero crossing of the least-squares line y(x).
 double zero_crossing(const std::vector<double>& x, const std::vector<double>& y) {
-  const double s = simtools::slope(x, y);
+  const double s = sim_run::slope(x, y);
   double mx = 0, my = 0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     mx += x[i] / static_cast<double>(x.size());
@@ -45,7 +45,7 @@ void rate_threshold(const ProcedureOptions& o, const ProcedureBase& base, const 
                     LimitsResult& res) {
   const double k = base.job.firmware.gyro.angular_gain;
   // b0 + a sin 4theta + c cos 4theta is lowest at 4 theta = atan2(a, c) + pi.
-  const simtools::BiasFit& f = adb.adb_raw;
+  const sim_run::BiasFit& f = adb.adb_raw;
   const double theta_min = (std::atan2(f.a_sin4, f.b_cos4) + kPi) / 4.0;
   const double scale_dph = std::max(f.amplitude() - f.b0, 1e-3);
   proc::Schedule sch(k);
@@ -61,21 +61,20 @@ void rate_threshold(const ProcedureOptions& o, const ProcedureBase& base, const 
     holds.push_back({sch.t(), sch.t() + hold_s});
     sch.hold(hold_s);
   }
-  const simtools::JobResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
+  const sim_run::RunResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   std::vector<double> in, raw, comp;
   double theta_sum = 0, d_true = 0, d_model = 0, n = 0;
   for (const Hold& h : holds) {
     ThresholdStep st;
     st.input_dph =
-        proc::rate_of(r.rows, &simtools::TelemetryRow::true_angle_deg, h.t0, h.t1) * 3600.0;
-    st.raw_dph = proc::rate_of(r.rows, &simtools::TelemetryRow::raw_angle_deg, h.t0, h.t1) * 3600.0;
-    st.comp_dph =
-        proc::rate_of(r.rows, &simtools::TelemetryRow::out_angle_deg, h.t0, h.t1) * 3600.0;
+        proc::rate_of(r.rows, &sim_run::TelemetryRow::true_angle_deg, h.t0, h.t1) * 3600.0;
+    st.raw_dph = proc::rate_of(r.rows, &sim_run::TelemetryRow::raw_angle_deg, h.t0, h.t1) * 3600.0;
+    st.comp_dph = proc::rate_of(r.rows, &sim_run::TelemetryRow::out_angle_deg, h.t0, h.t1) * 3600.0;
     res.threshold_steps.push_back(st);
     in.push_back(st.input_dph);
     raw.push_back(st.raw_dph);
     comp.push_back(st.comp_dph);
-    for (const simtools::TelemetryRow& row : r.rows) {
+    for (const sim_run::TelemetryRow& row : r.rows) {
       if (row.t_s < h.t0 || row.t_s > h.t1) continue;
       theta_sum += row.theta_deg;
       d_true += row.drift_true_dph;
@@ -115,13 +114,13 @@ void input_rate_limit(const ProcedureOptions& o, const ProcedureBase& base, Limi
   }
   sch.set_rate(0.0, now_dps / kAccelDps2);
   sch.hold(1.0);
-  const simtools::JobResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
+  const sim_run::RunResult r = proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   for (const auto& rec : records) {
     bool valid = true;
-    for (const simtools::TelemetryRow& row : r.rows)
+    for (const sim_run::TelemetryRow& row : r.rows)
       if (row.t_s >= rec[0] && row.t_s <= rec[1]) valid = valid && row.out_valid;
     const proc::MeanRates m =
-        proc::mean_rates(r.rows, &simtools::TelemetryRow::out_angle_deg, rec[0], rec[1]);
+        proc::mean_rates(r.rows, &sim_run::TelemetryRow::out_angle_deg, rec[0], rec[1]);
     const RateStep step{m.input, m.output, 0.0};
     const bool ok =
         valid && std::fabs(step.output_rad_s / step.input_rad_s - 1.0) * 1e6 < kFollowPpm;

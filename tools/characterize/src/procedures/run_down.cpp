@@ -23,20 +23,20 @@ RundownResult run_rundown(const ProcedureOptions& o) {
   sch.hold(5.0);
   const double t_off = sch.t();
   sch.hold(record_s);
-  simtools::JobConfig job = proc::scheduled_job(base, sch);
-  job.faults.push_back({t_off, simtools::FaultEvent::Kind::fault_input, 0, true});
-  const simtools::JobResult r = proc::run(job, o, res.wall_s, res.sim_s);
+  sim_run::RunConfig job = proc::scheduled_job(base, sch);
+  job.faults.push_back({t_off, sim_run::FaultEvent::Kind::fault_input, 0, true});
+  const sim_run::RunResult r = proc::run(job, o, res.wall_s, res.sim_s);
 
   const double t0 = t_off + 1.0;  // the rows' averaging span free of the drive
-  const simtools::TelemetryRow& first = proc::row_at(r.rows, t0);
+  const sim_run::TelemetryRow& first = proc::row_at(r.rows, t0);
   const sim::ResonatorParams& p = base.job.sim.resonator;
-  res.amplitude0_v = std::hypot(first.a_a_v, first.a_b_v);
+  res.amplitude0_v = std::hypot(first.a_A_v, first.a_B_v);
   res.noise_floor_v = r.noise_sigma_v;
   std::vector<double> t, log_a;
   double offset_deg = first.theta_deg - first.true_theta_deg;
-  for (const simtools::TelemetryRow& row : r.rows) {
+  for (const sim_run::TelemetryRow& row : r.rows) {
     if (row.t_s < t0) continue;
-    const double a = std::hypot(row.a_a_v, row.a_b_v);
+    const double a = std::hypot(row.a_A_v, row.a_B_v);
     const double tt = row.t_s - t0;
     res.t_s.push_back(tt);
     res.amplitude_v.push_back(a);
@@ -48,7 +48,7 @@ RundownResult run_rundown(const ProcedureOptions& o) {
     res.readout_error_max_deg =
         std::max(res.readout_error_max_deg, std::fabs(std::remainder(err, 90.0)));
   }
-  res.decay_rate_per_s = -simtools::slope(t, log_a);
+  res.decay_rate_per_s = -sim_run::slope(t, log_a);
   const double model_end = std::log(res.model_v.back() / res.amplitude0_v);
   res.decay_rate_predicted_per_s = -model_end / res.t_s.back();
   res.rundown_s = std::log(res.amplitude0_v / res.noise_floor_v) / res.decay_rate_per_s;

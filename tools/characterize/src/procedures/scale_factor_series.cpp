@@ -47,14 +47,14 @@ ScaleFactorResult run_scale_factor(const ProcedureOptions& o) {
   sch.hold(1.0);
 
   ScaleFactorResult res;
-  const simtools::JobResult run =
+  const sim_run::RunResult run =
       proc::run(proc::scheduled_job(base, sch), o, res.wall_s, res.sim_s);
   for (std::size_t i = 0; i < records.size(); ++i) {
-    const proc::MeanRates m = proc::mean_rates(run.rows, &simtools::TelemetryRow::out_angle_deg,
+    const proc::MeanRates m = proc::mean_rates(run.rows, &sim_run::TelemetryRow::out_angle_deg,
                                                records[i].t0_s, records[i].t1_s);
     res.steps.push_back({m.input, m.output, 0.0});
     if (i >= 2) continue;  // the readout's 4 theta pattern from the slowest steps
-    for (const simtools::TelemetryRow& row : run.rows) {
+    for (const sim_run::TelemetryRow& row : run.rows) {
       if (row.t_s < records[i].t0_s || row.t_s > records[i].t1_s || !row.out_valid) continue;
       res.true_theta_rad.push_back(row.true_theta_deg * kDeg);
       res.read_theta_rad.push_back(row.theta_deg * kDeg);

@@ -42,7 +42,7 @@ void add_angle_dependent_bias(DataSheet& sheet, const DriftResult& d) {
       "Parked angles", {"theta (deg)", "raw (deg/h)", "comp. (deg/h)", "model (deg/h)"}, {}};
   SheetSeries raw{"raw", "points", {}, {}, {}, {}}, comp{"compensated", "points", {}, {}, {}, {}};
   SheetSeries model{"true -D/K", "line", {}, {}, {}, {}};
-  for (const simtools::ParkResult& p : d.parks) {
+  for (const sim_run::ParkResult& p : d.parks) {
     const double th = p.theta_rad / kDeg;
     parks.rows.push_back({num("%.2f", th), num("%.3f", p.bias_raw_dph),
                           num("%.4f", p.bias_comp_dph), num("%.3f", p.bias_model_dph)});

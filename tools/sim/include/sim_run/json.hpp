@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // A small streaming JSON writer for report.json: objects, arrays, numbers,
 // strings, booleans. Non-finite numbers are written as null (JSON has no NaN).
@@ -32,4 +32,4 @@ class JsonWriter {
   bool first_ = true;
 };
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

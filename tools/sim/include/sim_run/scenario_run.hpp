@@ -3,9 +3,9 @@
 
 #include <string>
 
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // The run options of `hrg sim` that shape the schedule.
 struct ScheduleOptions {
@@ -25,14 +25,14 @@ struct ScheduleOptions {
 // a rate profile or with parked angles, parked angles with a rate profile.
 // Throws std::invalid_argument naming the options, sim::ScenarioError naming
 // the key, or std::runtime_error.
-JobConfig make_job(const std::string& scenario_path, const ScheduleOptions& o);
+RunConfig make_run(const std::string& scenario_path, const ScheduleOptions& o);
 
 // Copies job.sim's resonator and electrodes into the firmware's configuration
 // (K, chain centre and PLL range, Q, pump and forcer gains) and checks that
 // the chain can serve it. Throws std::invalid_argument naming `what`.
-void adopt_resonator(JobConfig& job, const std::string& what);
+void adopt_resonator(RunConfig& job, const std::string& what);
 
-// A job from a TOML scenario (sim_target/scenarios/*.toml), as make_job.
-JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o);
+// A job from a TOML scenario (sim_target/scenarios/*.toml), as make_run.
+RunConfig run_from_scenario(const std::string& path, const ScheduleOptions& o);
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

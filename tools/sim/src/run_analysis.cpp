@@ -7,9 +7,9 @@
 #include <numbers>
 
 #include "estimator/drift.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 
@@ -18,7 +18,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // Output minus truth accumulated between consecutive rows with a valid
 // output, the drift model's prediction for the raw error (it falls behind
 // the truth at D/K: Omega K = -2 theta' + D) and the tracking figures.
-void accumulate_errors(JobResult& r, const JobConfig& job) {
+void accumulate_errors(RunResult& r, const RunConfig& job) {
   double sum2 = 0;
   std::size_t n = 0;
   const double dt_h = 1.0 / job.telemetry_hz / 3600.0;
@@ -61,7 +61,7 @@ void accumulate_errors(JobResult& r, const JobConfig& job) {
 // model (compensation valid on every row): before that the output is the raw
 // angle plus an unproven model, and a slow-converging resonator would be
 // reported as not compensated at all.
-void parked_bias(JobResult& r, const JobConfig& job) {
+void parked_bias(RunResult& r, const RunConfig& job) {
   std::vector<double> th, braw, bcomp, bmodel, th_valid;
   for (const TelemetryRow& row : r.rows) {
     if (row.comp_valid) {
@@ -115,7 +115,7 @@ void parked_bias(JobResult& r, const JobConfig& job) {
 // Allan deviation of the compensated output rate (truth removed) over the
 // longest stretch with a valid output on a still table (no rate-table
 // motion, no commanded pattern move).
-void still_allan(JobResult& r, const JobConfig& job) {
+void still_allan(RunResult& r, const RunConfig& job) {
   const double earth_dps = job.earth_rate_rad_s / kDeg;
   std::size_t best_begin = 0, best_len = 0, begin = 0;
   for (std::size_t i = 0; i <= r.rows.size(); ++i) {
@@ -153,10 +153,10 @@ double true_drift_rad_s(const sim::ResonatorParams& p, double theta_rad, double 
   return est::resonator_drift_rad_s(Eigen::Map<const est::ParamVector>(t.data()), theta_rad, q);
 }
 
-void analyse_run(JobResult& r, const JobConfig& job) {
+void analyse_run(RunResult& r, const RunConfig& job) {
   accumulate_errors(r, job);
   parked_bias(r, job);
   still_allan(r, job);
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -9,7 +9,7 @@
 
 #include "hal/clock.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // Host monotonic clock (std::chrono::steady_clock), for timing tasks in
 // lockstep where the simulated clock does not move while a task runs.
@@ -52,4 +52,4 @@ class TextTable {
 // printf into a std::string.
 std::string fmt(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

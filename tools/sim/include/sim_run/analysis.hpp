@@ -5,7 +5,7 @@
 #include <span>
 #include <vector>
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 struct AllanPoint {
   double tau_s;
@@ -36,4 +36,4 @@ BiasFit fit_bias_4theta(std::span<const double> theta_rad, std::span<const doubl
 // Least-squares slope of y against t (e.g. angle error against time = bias).
 double slope(std::span<const double> t, std::span<const double> y);
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

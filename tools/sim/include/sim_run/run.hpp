@@ -13,7 +13,7 @@
 #include "firmware/app/firmware_config.hpp"
 #include "sim_target/control.hpp"
 #include "sim_target/sim_config.hpp"
-#include "sim_tools/analysis.hpp"
+#include "sim_run/analysis.hpp"
 
 namespace hrg::fw::app {
 class Firmware;
@@ -22,7 +22,7 @@ namespace hrg::sim {
 class SimTarget;
 }
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // One parked interval of the angle-dependent-bias test: the case is still,
 // the pattern sits at one angle, and the bias is the slope of the angle error.
@@ -42,7 +42,7 @@ struct FaultEvent {
 
 // Everything the main job needs: the simulated target, the firmware and its
 // parts, the input schedule and what to record.
-struct JobConfig {
+struct RunConfig {
   sim::SimConfig sim;
   fw::app::FirmwareConfig firmware;  // derived from `sim` by derive_firmware_config
   double duration_s = 0.0;
@@ -61,13 +61,13 @@ struct JobConfig {
 // the 4 theta circle, then the pattern parked at `bias_angles` angles on a
 // still base. `duration_s` <= 0 takes the default length; a longer duration
 // lengthens the parks; a shorter one drops the parks that do not fit.
-JobConfig default_job(double duration_s, int bias_angles = 16);
+RunConfig default_run(double duration_s, int bias_angles = 16);
 
 // The static-base variant: the same resonator on a still table (Earth rate
 // only). The firmware fills the 4 theta bins by turning the pattern on
 // purpose (pattern-angle command through the forcers) between windows; the
 // output is held while the pattern is moved. Default length 300 s.
-JobConfig static_base_job(double duration_s);
+RunConfig static_base_run(double duration_s);
 
 // The simulated board's converter layout, as the firmware's chain must know it.
 fw::ConverterLayout converter_layout(const sim::SimConfig& sim);
@@ -75,7 +75,7 @@ fw::ConverterLayout converter_layout(const sim::SimConfig& sim);
 // Fills the firmware's derived fields (chain converters, K and the set point
 // where they are copied) from the simulated board and `job.firmware.gyro`, so
 // that a scenario only has to describe the target.
-void derive_firmware_config(JobConfig& job);
+void derive_firmware_config(RunConfig& job);
 
 // One telemetry row (the recording's columns plus the truth).
 struct TelemetryRow {
@@ -87,7 +87,7 @@ struct TelemetryRow {
   double quad_v;
   int mode;
   double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
-  double a_a_v, a_b_v, drift_model_dph, drift_true_dph;
+  double a_A_v, a_B_v, drift_model_dph, drift_true_dph;
   double drift_control_dph;  // the control-loop part of drift_model_dph
   int out_valid;
   int pattern_cmd;  // the pattern is being moved on purpose
@@ -120,7 +120,7 @@ struct TaskFigures {
   uint64_t runs = 0;
 };
 
-struct JobResult {
+struct RunResult {
   bool reached_operate = false;
   double t_operate_s = -1.0;  // first time in operate
   fw::Mode final_mode = fw::Mode::power_up;
@@ -197,7 +197,7 @@ struct RunOptions {
   std::string can_log;     // when not empty: every CAN frame as a candump log
   bool real_time = false;  // pace frames by CLOCK_MONOTONIC (1 ms) instead of lockstep
   int rt_priority = 80;    // SCHED_FIFO priority asked for in real time
-  bool profile = false;    // time the simulated target's stages (JobResult::sim_stages)
+  bool profile = false;    // time the simulated target's stages (RunResult::sim_stages)
   // Called every observe_every_s of simulated time with the firmware and the
   // simulated target (benches and studies that follow the identification).
   std::function<void(const fw::app::Firmware&, const sim::SimTarget&)> observer;
@@ -207,11 +207,11 @@ struct RunOptions {
 // Runs firmware + simulated target: in lockstep (as fast as the host allows,
 // deterministic) or paced in real time with the same executive code, where
 // deadline misses are counted and the real-time setup is reported.
-JobResult run_job(const JobConfig& job, const RunOptions& options);
+RunResult run_simulation(const RunConfig& job, const RunOptions& options);
 
 // Fills the figures of `r` from its rows (errors against the truth, the
 // parked-angle bias and its fits, the Allan deviation on a still table).
-void analyse_run(JobResult& r, const JobConfig& job);
+void analyse_run(RunResult& r, const RunConfig& job);
 
 // The true drift D (rad/s, Omega K units) of the resonator at pattern angle
 // theta with quadrature ratio a_B/a_A (physics.md section 3, D_nu + D_w).
@@ -220,4 +220,4 @@ double true_drift_rad_s(const sim::ResonatorParams& p, double theta_rad, double 
 // p = (nu, dnu_C, dnu_S, dw_C, dw_S) of the simulated resonator.
 std::array<double, 5> true_parameters(const sim::ResonatorParams& p);
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

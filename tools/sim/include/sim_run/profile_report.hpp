@@ -8,10 +8,10 @@
 
 #include <string>
 
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
-std::string format_profile(const JobResult& r);
+std::string format_profile(const RunResult& r);
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -7,14 +7,14 @@
 #include <vector>
 
 #include "recording/recording.hpp"
-#include "sim_tools/job.hpp"
+#include "sim_run/run.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // report.json: realtime_factor, excitation_off_fraction, drift.{raw,compensated}
 // .{adb_dph, mean_dph}, identification (estimate, sigma, truth per parameter),
 // executive (per task max time and overruns), checks.
-std::string report_json(const JobConfig& job, const JobResult& r);
+std::string report_json(const RunConfig& job, const RunResult& r);
 
 // How a long run's telemetry file is kept small: every decimate-th row only
 // (the metadata says so), and a new file every rotate_s simulated seconds
@@ -27,24 +27,24 @@ struct TelemetryFileOptions {
 // telemetry.csv: hrg-recording v1 plus theta_deg, out_angle_deg,
 // true_angle_deg, mode and the truth columns. Returns the files written.
 std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& path,
-                                                   const JobConfig& job, const JobResult& r,
+                                                   const RunConfig& job, const RunResult& r,
                                                    const TelemetryFileOptions& o = {});
 // The same telemetry as a recording in memory.
-recording::Recording telemetry_recording(const JobConfig& job, const JobResult& r);
+recording::Recording telemetry_recording(const RunConfig& job, const RunResult& r);
 
 // bias.csv (one row per parked angle) and allan.csv (tau, adev) for the plots.
-void write_bias_csv(const std::filesystem::path& path, const JobResult& r);
-void write_allan_csv(const std::filesystem::path& path, const JobResult& r);
+void write_bias_csv(const std::filesystem::path& path, const RunResult& r);
+void write_allan_csv(const std::filesystem::path& path, const RunResult& r);
 
 // The end-of-run summary table.
-void print_summary(std::FILE* out, const JobConfig& job, const JobResult& r);
+void print_summary(std::FILE* out, const RunConfig& job, const RunResult& r);
 
 // How many parks the compensated bias was measured on (the model valid
 // throughout), since when, and the run length the resonator needs.
-std::string bias_test_coverage(const JobResult& r);
+std::string bias_test_coverage(const RunResult& r);
 
 // Fills r.failures with what makes the run a failure (see the checks in
 // report_json); returns true when the run passed.
-bool judge(const JobConfig& job, JobResult& r);
+bool judge(const RunConfig& job, RunResult& r);
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

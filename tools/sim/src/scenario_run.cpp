@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
-#include "sim_tools/scenario_job.hpp"
+#include "sim_run/scenario_run.hpp"
 
 #include <stdexcept>
 
 #include "dsp/chain.hpp"
 #include "sim_target/scenario.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 namespace {
 
@@ -32,7 +32,7 @@ void refuse_conflicts(const std::string& path, bool own_profile, const ScheduleO
 
 }  // namespace
 
-void adopt_resonator(JobConfig& job, const std::string& what) {
+void adopt_resonator(RunConfig& job, const std::string& what) {
   const sim::SimConfig& sc = job.sim;
   job.firmware.gyro.angular_gain = sc.resonator.angular_gain;
   derive_firmware_config(job);
@@ -48,20 +48,20 @@ void adopt_resonator(JobConfig& job, const std::string& what) {
     throw std::invalid_argument(what + ": signal chain configuration: " + err);
 }
 
-JobConfig make_job(const std::string& scenario_path, const ScheduleOptions& o) {
-  if (!scenario_path.empty()) return job_from_scenario(scenario_path, o);
+RunConfig make_run(const std::string& scenario_path, const ScheduleOptions& o) {
+  if (!scenario_path.empty()) return run_from_scenario(scenario_path, o);
   refuse_conflicts("", false, o);
-  if (o.static_base) return static_base_job(o.duration_s);
-  return default_job(o.duration_s, o.bias_angles > 0 ? o.bias_angles : kDefaultBiasAngles);
+  if (o.static_base) return static_base_run(o.duration_s);
+  return default_run(o.duration_s, o.bias_angles > 0 ? o.bias_angles : kDefaultBiasAngles);
 }
 
-JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o) {
+RunConfig run_from_scenario(const std::string& path, const ScheduleOptions& o) {
   const sim::SimConfig sc = sim::load_scenario(path);
   const bool own_profile = !sc.rate_rad_s.is_constant();
   refuse_conflicts(path, own_profile, o);
   const int bias_angles = o.bias_angles > 0 ? o.bias_angles : kDefaultBiasAngles;
-  JobConfig job =
-      o.static_base ? static_base_job(o.duration_s) : default_job(o.duration_s, bias_angles);
+  RunConfig job =
+      o.static_base ? static_base_run(o.duration_s) : default_run(o.duration_s, bias_angles);
   const sim::Profile schedule = job.sim.rate_rad_s;
   const double default_earth = job.earth_rate_rad_s;
   job.sim = sc;
@@ -87,4 +87,4 @@ JobConfig job_from_scenario(const std::string& path, const ScheduleOptions& o) {
   return job;
 }
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run

@@ -8,7 +8,7 @@
 
 #include "sim_target/profile.hpp"
 
-namespace hrg::simtools {
+namespace hrg::sim_run {
 
 // Ring-up from rest (forcers, then the pump) and lock take about 35 s: the
 // rate table stays still this long before it turns.
@@ -46,4 +46,4 @@ struct TableSchedule {
   }
 };
 
-}  // namespace hrg::simtools
+}  // namespace hrg::sim_run
