@@ -146,10 +146,12 @@ if [ -x /usr/bin/hrg-board ] && [ -x /usr/bin/hrg ]; then
   # 50 s: ring-up and lock take 35 s, then free-decay windows every 2 s. In
   # lockstep: the emulated CPU cannot keep the 1 kHz frames in real time; the
   # recording's time is the firmware's own (HRG_ROW.t_s), not the capture's.
+  # The simulated lines, not gpio-sim's: the simulated resonator is excited
+  # only through its own excitation switch (HRG_GPIO_CHIP is set above).
   step "audit-grade CAN telemetry: hrg-board on vcan0 -> candump -> hrg can-decode -> hrg audit"
   candump -r 8000000 -L vcan0 > /tmp/null.log &
   dump=$!
-  hrg-board --can vcan0 --lockstep --seconds 50 > /tmp/null-board.out 2>&1
+  (unset HRG_GPIO_CHIP; hrg-board --can vcan0 --lockstep --seconds 50) > /tmp/null-board.out 2>&1
   null_rc=$?
   sleep 0.2
   kill $dump
