@@ -76,11 +76,15 @@ can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& c
   // The DAC's pipeline is counted once more on top of the chain's lead (which
   // holds it already): a row is called drive-free one block late rather
   // than early.
-  e.drive_free_blocks =
-      static_cast<uint32_t>(1.0 + std::ceil((chain.dac_lead_frames + conv.dac_latency_samples +
-                                             (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
-                                            l));
+  e.drive_free_blocks = drive_free_blocks(chain, conv.dac_latency_samples);
   return e;
+}
+
+uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_samples) {
+  const double l = static_cast<double>(chain.block_frames);
+  return static_cast<uint32_t>(1.0 + std::ceil((chain.dac_lead_frames + dac_latency_samples +
+                                                (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
+                                               l));
 }
 
 }  // namespace hrg::fw::app

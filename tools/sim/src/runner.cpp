@@ -154,15 +154,9 @@ class RowStamper {
   static constexpr std::size_t kHistory = kCentre + 2;
 
   explicit RowStamper(const RunConfig& job) : f_ref_hz_(job.firmware.chain.f_center_hz) {
-    // A row is free of any drive once the last driven DAC word (played
-    // dac_lead_frames + the DAC's pipeline latency after its block) lies
-    // before the N (L - 1) + 1 samples the demodulator averages.
-    const double l = static_cast<double>(job.firmware.chain.block_frames);
-    drive_free_blocks_ =
-        static_cast<uint64_t>(1.0 + std::ceil((job.firmware.chain.dac_lead_frames +
-                                               static_cast<double>(job.sim.dac.latency_samples) +
-                                               (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
-                                              l));
+    // The simulated DAC's own latency: the truth, not the firmware's layout.
+    drive_free_blocks_ = fw::app::drive_free_blocks(
+        job.firmware.chain, static_cast<double>(job.sim.dac.latency_samples));
     off_blocks_ = drive_free_blocks_;
   }
 

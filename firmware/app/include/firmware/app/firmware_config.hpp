@@ -59,4 +59,9 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv);
 can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& chain,
                                                        const ConverterLayout& conv);
 
+// Blocks after the drives go off until a demodulated row is free of them: the
+// last driven DAC word (played dac_lead_frames + `dac_latency_samples` after
+// its block) lies before the N (L - 1) + 1 samples the demodulator averages.
+uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_samples);
+
 }  // namespace hrg::fw::app
