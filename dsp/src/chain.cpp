@@ -126,7 +126,7 @@ const char* check_chain_config(const ChainConfig& c) {
 
 template <typename T>
 Chain<T>::Chain(const ChainConfig& cfg)
-    : cfg_(cfg), demod_(cfg.block_frames), correction_(cfg.block_frames) {
+    : cfg_(cfg), demod_(cfg.block_frames), pump_seen_(cfg.block_frames) {
   usable_ = check_chain_config(cfg) == nullptr;
   if (!usable_) return;
   const double w = 2.0 * kPi * cfg.f_center_hz;
@@ -147,7 +147,7 @@ Chain<T>::Chain(const ChainConfig& cfg)
 template <typename T>
 void Chain<T>::reset() {
   demod_.reset();
-  correction_.reset();
+  pump_seen_.reset();
   pump_env_re_v_ = pump_env_im_v_ = 0.0;
   pll_.reset();
   lock_.reset();
@@ -187,7 +187,11 @@ bool Chain<T>::process(std::span<const q31_t> adc, std::span<q31_t> dac) {
   QuadSample<T> qs;
   demod_.process_block(adc, phase_, step_, qs);
   // The pump written after the previous ADC block acted during this one.
-  correction_.apply(pump_env_re_v_, pump_env_im_v_, qs);
+  double seen_re_v = 0.0;
+  double seen_im_v = 0.0;
+  pump_seen_.push(pump_env_re_v_, pump_env_im_v_, seen_re_v, seen_im_v);
+  correction_.apply(seen_re_v, seen_im_v, qs);
+  out_.pump_seen_v = std::hypot(seen_re_v, seen_im_v);
 
   const double fs_v = cfg_.adc_full_scale_v;
   const Quadratures<double> q{Ops::to_f64(qs.cx) * fs_v, Ops::to_f64(qs.sx) * fs_v,

@@ -25,18 +25,16 @@ bool ElectronicsCorrection<T>::configure(const PickoffCorrection<double>& pickof
   has_feedthrough_ = k.x_re != 0.0 || k.x_im != 0.0 || k.y_re != 0.0 || k.y_im != 0.0;
   inv_dac_fs_ = 1.0 / dac_full_scale_v;
   active_ = true;
-  envelope_.reset();
   return true;
 }
 
 template <typename T>
-void ElectronicsCorrection<T>::apply(double pump_re_v, double pump_im_v, QuadSample<T>& q) {
+void ElectronicsCorrection<T>::apply(double seen_re_v, double seen_im_v, QuadSample<T>& q) {
   if (!active_) return;
   bool saturated = false;
   if (has_feedthrough_) {
-    double re = 0.0;
-    double im = 0.0;
-    envelope_.push(pump_re_v * inv_dac_fs_, pump_im_v * inv_dac_fs_, re, im);
+    const double re = seen_re_v * inv_dac_fs_;
+    const double im = seen_im_v * inv_dac_fs_;
     if constexpr (std::is_same_v<T, q31_t>) {
       saturated |=
           remove_feedthrough_q31(feedthrough_, q31_from_f64_sat(re), q31_from_f64_sat(im), q);

@@ -302,6 +302,7 @@ void Gyro::task_telemetry(Gyro& g) {
   s.pll_locked = st.chain.locked;
   s.quad_effort = st.chain.quad_effort;
   s.pump_v = st.chain.pump_v;
+  s.row_pump_v = st.chain.pump_seen_v;
   s.agc_setpoint_v = g.cfg_.amplitude_set_v;
   s.mode = st.mode;
   s.exc_on = st.excitation_on;

@@ -115,7 +115,11 @@ struct ChainOutputs {
   double theta_A_rad = 0.0;     // unwrapped pattern angle
   double phase_err_rad = 0.0;   // PLL phase detector output (wave phase mod pi)
   double pll_freq_hz = 0.0;     // NCO frequency for the next block
-  double pump_v = 0.0;          // pump amplitude V0
+  double pump_v = 0.0;          // pump amplitude V0 written for the next block
+  // Amplitude of the pump envelope that this block's quadratures saw: the
+  // decimator's weights over the blocks whose pump acted in its window (what
+  // a drive feedthrough in them is proportional to), V.
+  double pump_seen_v = 0.0;
   double pump_phase_rad = 0.0;  // phi_V against the NCO
   double quad_effort_v = 0.0;   // u_q, forcer volts along the node
   double quad_effort = 0.0;     // u_q / forcer_max_v, -1..1
@@ -201,6 +205,7 @@ class Chain {
   bool usable_ = false;
   Demodulator<T> demod_;
   ElectronicsCorrection<T> correction_;
+  PumpEnvelopeFilter pump_seen_;
   Pll pll_;
   LockDetector lock_;
   Agc agc_;

@@ -119,7 +119,7 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       break;
     case Tm::row:
       put(m, sig::row_t_s, s.row_t_s, f);
-      put(m, sig::row_pump_v, s.pump_v, f);
+      put(m, sig::row_pump_v, s.row_pump_v, f);
       put(m, sig::row_exc, b(s.row_exc), f);
       break;
     case Tm::reference: put(m, sig::f_ref_hz, s.f_ref_hz, f); break;

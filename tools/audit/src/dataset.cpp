@@ -283,23 +283,41 @@ Block make_block(const Rows& r, const Dataset& d, std::size_t b0, std::size_t b1
   return b;
 }
 
+// Rows of the excitation run `fr` at its end next to the free segment
+// (its start when !at_start) whose pump is already off while the run still
+// says excitation: a producer that marks a row free only once its whole
+// averaging span is (exc stays 1 over the demodulator's span) leaves such
+// rows, whose signals have already lost the pump's feedthrough. They are
+// neither forced nor free evidence at the edge.
+std::size_t pump_off_rows_at_edge(const Rows& r, const Run& fr, bool at_start) {
+  if (!r.pump) return 0;
+  const std::size_t run_rows = fr.last - fr.first + 1;
+  std::size_t k = 0;
+  while (k < run_rows && (*r.pump)[at_start ? fr.last - k : fr.first + k] == 0.0)
+    ++k;
+  return k == run_rows ? 0 : k;  // a run without any pump keeps its rows
+}
+
 // The switching edge between free segment `seg_index` and the excitation run
 // `fr` next to it (before it when at_start).
 void add_edge(const Rows& r, const Run& fr, std::size_t seg_index, bool at_start, Dataset& d) {
   Edge e;
   e.free_segment = seg_index;
   e.at_start = at_start;
-  const std::size_t m = std::min<std::size_t>(kEdgeRows, fr.last - fr.first + 1);
+  const std::size_t skip = pump_off_rows_at_edge(r, fr, at_start);
+  const std::size_t run_rows = fr.last - fr.first + 1 - skip;
+  auto row_at = [&](std::size_t j) { return at_start ? fr.last - skip - j : fr.first + skip + j; };
+  const std::size_t m = std::min<std::size_t>(kEdgeRows, run_rows);
   double v = 0.0;
   for (std::size_t j = 0; j < m; ++j) {
-    const std::size_t row = at_start ? fr.last - j : fr.first + j;
+    const std::size_t row = row_at(j);
     e.forced_rows.push_back(row);
+    if (r.pump) e.forced_pump_v.push_back(std::abs((*r.pump)[row]));
     v += r.pump ? std::abs((*r.pump)[row]) / static_cast<double>(m) : 1.0 / static_cast<double>(m);
   }
   e.pump_v = v;
-  const std::size_t run_rows = fr.last - fr.first + 1;
   for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j)
-    e.slope_rows.push_back(at_start ? fr.last - j : fr.first + j);
+    e.slope_rows.push_back(row_at(j));
   if (m >= 4) d.edges.push_back(e);
 }
 

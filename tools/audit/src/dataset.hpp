@@ -60,7 +60,8 @@ struct Edge {
   // jump's (a direction taken from the jump's own rows bends the jump's noise
   // towards it and biases the sign-free statistic).
   std::vector<std::size_t> slope_rows;
-  double pump_v = 0.0;
+  double pump_v = 0.0;                 // mean |pump_v| over forced_rows (1 without the column)
+  std::vector<double> forced_pump_v;   // |pump_v| of each forced row (empty without the column)
 };
 
 struct Dataset {

@@ -58,6 +58,9 @@ struct EdgeJump {
   double pump_v = 0.0;
 };
 
+// Least share of an edge's mean pump that its fitted pump at the edge keeps.
+constexpr double kMinEdgePumpShare = 0.25;
+
 EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   EdgeJump ej;
   double phase = 0.0;
@@ -70,11 +73,13 @@ EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   const double dt = std::abs(d.t_s[near] - d.t_s[free_row]);
   Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
   Eigen::Matrix<cplx, 3, 2> b = Eigen::Matrix<cplx, 3, 2>::Zero();
+  Eigen::Vector3d bv = Eigen::Vector3d::Zero();
   for (std::size_t j = 0; j < e.forced_rows.size(); ++j) {
     const std::size_t row = e.forced_rows[j];
     const double tau = (d.t_s[row] - t_e) / dt;
     const Eigen::Vector3d f(1.0, tau, tau * tau);
     s += f * f.transpose();
+    if (!e.forced_pump_v.empty()) bv += f * e.forced_pump_v[j];
     b.row(0) += f(0) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
     b.row(1) += f(1) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
     b.row(2) += f(2) * Eigen::RowVector2cd(d.x[row] - pred[j][0], d.y[row] - pred[j][1]);
@@ -110,7 +115,12 @@ EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   ej.j = ej.proj * r0;
   ej.var = si(0, 0) * d.noise_v * d.noise_v;
   ej.phasor = std::polar(1.0, phase);
-  ej.pump_v = std::max(e.pump_v, 1e-12);
+  // The jump is the rows' fit extrapolated to the edge; a feedthrough in
+  // them follows each row's pump, so the pump that goes with the jump is the
+  // same fit of the pump column (a steady pump: its mean; a pump that the
+  // loop moves from row to row: what is left of it at the edge).
+  const double pump_at_edge = e.forced_pump_v.empty() ? e.pump_v : (si * bv)(0);
+  ej.pump_v = std::max(pump_at_edge, 1e-12);
   return ej;
 }
 
@@ -226,8 +236,16 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   }
   if (d.edges.size() < 3 || used.size() < 3) return fs;
   std::vector<EdgeJump> jumps;
-  for (const auto* e : used)
-    jumps.push_back(edge_jump(d, p, *e));
+  std::vector<const Edge*> kept;
+  for (const auto* e : used) {
+    // An edge where the fitted pump is a small part of the rows' own is not
+    // evidence: the pump there is what the fit leaves of a moving one.
+    const EdgeJump ej = edge_jump(d, p, *e);
+    if (ej.pump_v < kMinEdgePumpShare * e->pump_v) continue;
+    jumps.push_back(ej);
+    kept.push_back(e);
+  }
+  used.swap(kept);
   fs.dropped = drop_transients(jumps, used);
   if (jumps.size() < 3) return fs;
   const bool debug = std::getenv("HRG_AUDIT_DEBUG") != nullptr;

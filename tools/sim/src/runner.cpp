@@ -231,7 +231,7 @@ void record_row(RunResult& r, const RunConfig& job, const fw::Gyro& g, const Row
   row.sy_v = ch.quad_v.sy * c - ch.quad_v.cy * s;
   row.exc = stamp.drive_free() ? 0 : 1;
   row.excitation_cmd = st.excitation_on ? 1 : 0;
-  row.pump_v = ch.pump_v;
+  row.pump_v = ch.pump_seen_v;  // the pump the row's quadratures saw
   row.temp_c = ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;
   row.pll_hz = ch.pll_freq_hz;

@@ -29,7 +29,8 @@ struct TelemetrySnapshot {
   double pll_freq_hz = 0;
   bool pll_locked = false;
   double quad_effort = 0;  // quadrature forcer command, fraction of full scale [-1, 1]
-  double pump_v = 0;       // pump amplitude at the electrode
+  double pump_v = 0;       // pump amplitude at the electrode, written for the next block
+  double row_pump_v = 0;   // pump amplitude the row's quadratures saw (its demodulator window)
   double pump_phase_rad = 0;
   double agc_setpoint_v = 0;  // wave amplitude set point at the pickoff
   Mode mode = Mode::power_up;
