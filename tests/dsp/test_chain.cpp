@@ -324,3 +324,44 @@ TEST(ChainDriftInputs, FirstBlockAndPumpOffReportNoPhaseErrorAndEffortIsAFractio
   chain.process(tone_block(100, 5000.0, 0.4, 1e-3), dac);
   DOUBLES_EQUAL(0.0, chain.outputs().pump_phase_error_rad, 0.0);
 }
+
+// The pump a block's quadratures saw: the decimator's weights over the pump
+// envelopes that acted in its window (each written after the block before),
+// which a drive feedthrough in them is proportional to. Steady: the pump
+// itself; kDecimatorOrder blocks after a switch-off: none.
+TEST(Chain, PumpSeenIsTheDecimatorWeightedPumpThatActed) {
+  ChainConfig cfg;
+  Chain<double> chain(cfg);
+  std::vector<q31_t> dac(300, 0);
+  PumpEnvelopeFilter filter(cfg.block_frames);
+  double written_re_v = 0.0;
+  double written_im_v = 0.0;
+  double t_s = 0.0;
+  // A wave below the ring-up threshold: the pump runs at its limit while on.
+  auto step = [&](bool pump_on) {
+    chain.set_drive_enables(pump_on, false);
+    chain.process(tone_block(cfg.block_frames, 5000.0, 0.02, t_s), dac);
+    t_s += cfg.block_frames / cfg.sample_rate_hz;
+    double re = 0.0;
+    double im = 0.0;
+    filter.push(written_re_v, written_im_v, re, im);
+    DOUBLES_EQUAL(std::hypot(re, im), chain.outputs().pump_seen_v, 1e-12);
+    written_re_v = chain.outputs().pump_v * std::cos(chain.outputs().pump_phase_rad);
+    written_im_v = chain.outputs().pump_v * std::sin(chain.outputs().pump_phase_rad);
+  };
+  for (int n = 0; n < 20; ++n)
+    step(true);
+  DOUBLES_EQUAL(cfg.pump_max_v, chain.outputs().pump_v, 0.0);
+  // Steady pump: the weights sum to one (the wave phase barely moves).
+  DOUBLES_EQUAL(cfg.pump_max_v, chain.outputs().pump_seen_v, 1e-3 * cfg.pump_max_v);
+  step(false);  // the block that writes the pump off still saw it
+  DOUBLES_EQUAL(cfg.pump_max_v, chain.outputs().pump_seen_v, 1e-3 * cfg.pump_max_v);
+  for (uint32_t k = 0; k < kDecimatorOrder; ++k) {
+    step(false);
+    CHECK(chain.outputs().pump_seen_v < cfg.pump_max_v);
+  }
+  DOUBLES_EQUAL(0.0, chain.outputs().pump_seen_v, 0.0);
+  // On and off from block to block: what acted, not what was written last.
+  for (int n = 0; n < 12; ++n)
+    step(n % 3 == 0);
+}

@@ -138,7 +138,7 @@ TEST(DbcAgreesWithCode, FramesEncodedByTheFirmwareDecodeThroughTheDbc) {
   DOUBLES_EQUAL(-0.0123, dbc().message(f.id)->signal("dw_s_rad_s")->decode(f), 1e-12);
   DOUBLES_EQUAL(7, dbc().message(f.id)->signal("seq")->decode(f), 0);
   s.row_t_s = 3599.9995;
-  s.pump_v = 9.518;
+  s.row_pump_v = 9.518;
   s.row_exc = false;
   encode_telemetry(Tm::row, s, 9, f);
   DOUBLES_EQUAL(3599.9995, dbc().message(f.id)->signal("t_s")->decode(f), 1e-9);

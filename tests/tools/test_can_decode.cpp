@@ -33,6 +33,7 @@ TelemetrySnapshot sample(int k) {
   s.row_t_s = 0.1 + 1e-3 * k - 2.5e-3;   // the envelope's centre, 0.1 s after boot
   s.f_ref_hz = 4999.87312;
   s.pump_v = 9.5 + 1e-3 * k;
+  s.row_pump_v = 9.4 + 1e-3 * k;  // the pump the row's envelopes saw, not the one written next
   s.temp_c = 31.25;
   s.pll_freq_hz = 4999.87310 + 1e-4 * k;
   s.angular_gain = 0.554;
@@ -120,7 +121,7 @@ TEST(CanDecode, RowsAreTheTransmittedSamplesAndLossesAreCountedPerMessage) {
     DOUBLES_EQUAL(want.cy_v, rec.column("cy_v")[r], 0.5e-6);
     DOUBLES_EQUAL(want.row_exc ? 1.0 : 0.0, rec.column("exc")[r], 0);
     DOUBLES_EQUAL(want.exc_on ? 1.0 : 0.0, rec.column("exc_cmd")[r], 0);
-    DOUBLES_EQUAL(want.pump_v, rec.column("pump_v")[r], 0.5e-3);
+    DOUBLES_EQUAL(want.row_pump_v, rec.column("pump_v")[r], 0.5e-3);
     if (k == 0) continue;                                // before the bench's first frame
     DOUBLES_EQUAL(24.5, rec.column("temp_c")[r], 1e-9);  // the chamber's, not STATUS
     DOUBLES_EQUAL(table_rate_dps(k), rec.column("rate_dps")[r], 0.5e-6);

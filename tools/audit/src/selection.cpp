@@ -238,10 +238,11 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
   std::vector<EdgeJump> jumps;
   std::vector<const Edge*> kept;
   for (const auto* e : used) {
-    // An edge where the fitted pump is a small part of the rows' own is not
-    // evidence: the pump there is what the fit leaves of a moving one.
+    // An edge without a pump (forcers alone) or where the fitted pump is a
+    // small part of the rows' own is not evidence: there is no feedthrough
+    // to see, or the pump there is what the fit leaves of a moving one.
     const EdgeJump ej = edge_jump(d, p, *e);
-    if (ej.pump_v < kMinEdgePumpShare * e->pump_v) continue;
+    if (!(e->pump_v > 0.0) || ej.pump_v < kMinEdgePumpShare * e->pump_v) continue;
     jumps.push_back(ej);
     kept.push_back(e);
   }
