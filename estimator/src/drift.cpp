@@ -19,6 +19,14 @@ double resonator_drift_rad_s(const ParamVector& p, double theta_A_rad, double aB
   return (d_nu * (1.0 + q * q) - 2.0 * q * w_cos) / (1.0 - q * q);
 }
 
+ParamVector with_damping_scale(const ParamVector& p, double damping_scale) {
+  ParamVector out = p;
+  out(kNu) *= damping_scale;
+  out(kDnuC) *= damping_scale;
+  out(kDnuS) *= damping_scale;
+  return out;
+}
+
 double DriftCompensator::step(double theta_A_rad, double aB_over_aA, double d_phi_rad_s,
                               double dt_s) {
   const double d =
@@ -61,6 +69,7 @@ bool ControlDriftEstimator::add_sample(const Sample& s) {
   acc_.tan_eps += std::tan(s.pump_phase_error_rad);
   acc_.qs += s.quad_force_sin_v_s;
   acc_.qc += s.quad_force_cos_v_s;
+  acc_.k += s.damping_scale;
   ++acc_.n;
   if (s.t_s - t_block_start_s_ < config_.block_s) return true;
 
@@ -74,6 +83,7 @@ bool ControlDriftEstimator::add_sample(const Sample& s) {
   b.tan_eps *= inv;
   b.qs *= inv;
   b.qc *= inv;
+  b.k /= b.n;  // exactly 1 for the seed model (no rounding of inv)
   acc_ = Block{};
   t_block_start_s_ = s.t_s;
   if (have_prev_) {
@@ -84,10 +94,12 @@ bool ControlDriftEstimator::add_sample(const Sample& s) {
     const double c4 = 0.5 * (b.c4 + prev_.c4);
     const double s4 = 0.5 * (b.s4 + prev_.s4);
     const double tan_eps = 0.5 * (b.tan_eps + prev_.tan_eps);
-    const double dnu = p_(kDnuC) * c4 + p_(kDnuS) * s4;
+    const double k = 0.5 * (b.k + prev_.k);
+    const double nu = k * p_(kNu);
+    const double dnu = k * (p_(kDnuC) * c4 + p_(kDnuS) * s4);
     const double g = p_(kDwC) * s4 - p_(kDwS) * c4;
-    const double fA = (b.aA - prev_.aA) / dt + (p_(kNu) + dnu) * aA + g * aB;
-    const double fB = (b.aB - prev_.aB) / dt + (p_(kNu) - dnu) * aB - g * aA;
+    const double fA = (b.aA - prev_.aA) / dt + (nu + dnu) * aA + g * aB;
+    const double fB = (b.aB - prev_.aB) / dt + (nu - dnu) * aB - g * aA;
     const double qs = 0.5 * (b.qs + prev_.qs);
     const double qc = 0.5 * (b.qc + prev_.qc);
     const double fA_cos = fA * tan_eps;
@@ -163,8 +175,9 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
   w_last_ = w;
   const double dnu = p_(kDnuC) * c4 + p_(kDnuS) * s4;
   const double g = p_(kDwC) * s4 - p_(kDwS) * c4;
-  // Integrands: the three pump regressors and the known decay rate.
-  const Vec4 h(w, w * c4, w * s4, p_(kNu) + dnu + g * s.a_B_v / s.a_A_v);
+  // Integrands: the three pump regressors and the known decay rate (the
+  // damping at this sample's scale).
+  const Vec4 h(w, w * c4, w * s4, s.damping_scale * (p_(kNu) + dnu) + g * s.a_B_v / s.a_A_v);
   const double ln_a = std::log(s.a_A_v);
   if (!started_) {
     started_ = true;

@@ -44,7 +44,8 @@ Status WindowAccumulator::begin_window(double t_switch_s) {
 Status WindowAccumulator::add_sample(const WaveSample& s) {
   if (!open_) return Status::not_in_window;
   if (!std::isfinite(s.t_s) || !std::isfinite(s.a_A_v) || !std::isfinite(s.a_B_v) ||
-      !std::isfinite(s.theta_A_rad) || !std::isfinite(s.E_v2) || !(s.a_A_v > 0) || !(s.E_v2 > 0)) {
+      !std::isfinite(s.theta_A_rad) || !std::isfinite(s.E_v2) || !(s.a_A_v > 0) || !(s.E_v2 > 0) ||
+      !(s.damping_scale > 0) || !std::isfinite(s.damping_scale)) {
     open_ = false;
     return Status::bad_sample;
   }
@@ -56,9 +57,11 @@ Status WindowAccumulator::add_sample(const WaveSample& s) {
   const double s4 = std::sin(4.0 * s.theta_A_rad);
   const double P = s.a_A_v * s.a_A_v - s.a_B_v * s.a_B_v;
   const double u = s.a_A_v * s.a_B_v;
-  // Integrands of F_E (columns nu, dnu_C, dnu_S) and F_Q (nu, dw_C, dw_S).
-  const Eigen::Vector3d hE(-s.E_v2, -P * c4, -P * s4);
-  const Eigen::Vector3d hQ(-2.0 * u, P * s4, -P * c4);
+  // Integrands of F_E (columns nu, dnu_C, dnu_S) and F_Q (nu, dw_C, dw_S);
+  // the damping columns carry the known scale of the damping at this sample.
+  const double k = s.damping_scale;
+  const Eigen::Vector3d hE(-k * s.E_v2, -k * P * c4, -k * P * s4);
+  const Eigen::Vector3d hQ(-2.0 * k * u, P * s4, -P * c4);
   if (!have_first_) {
     have_first_ = true;
     t_first_s_ = t_prev_s_ = t_block_start_s_ = s.t_s;

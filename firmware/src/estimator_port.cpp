@@ -9,15 +9,16 @@ namespace {
 
 // The record's values in the estimator's sample types (the estimator does not
 // see dsp/, so the chain's record is translated here and nowhere else).
-est::WaveSample wave_sample(const ChainRecord& s) {
+est::WaveSample wave_sample(const ChainRecord& s, double damping_scale) {
   return {.t_s = s.t_s,
           .a_A_v = s.wave.a_A_v,
           .a_B_v = s.wave.a_B_v,
           .theta_A_rad = s.theta_A_rad,
-          .E_v2 = s.wave.E_v2};
+          .E_v2 = s.wave.E_v2,
+          .damping_scale = damping_scale};
 }
 
-est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s) {
+est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s, double damping_scale) {
   return {.t_s = s.t_s,
           .a_A_v = s.wave.a_A_v,
           .a_B_v = s.wave.a_B_v,
@@ -25,7 +26,8 @@ est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s) {
           .pump_phase_error_rad = s.pump_phase_error_rad,
           .quad_force_sin_v_s = s.quad_force_sin_v_s,
           .quad_force_cos_v_s = s.quad_force_cos_v_s,
-          .pump_v = s.pump_v};
+          .pump_v = s.pump_v,
+          .damping_scale = damping_scale};
 }
 
 }  // namespace
@@ -52,7 +54,7 @@ void EstimatorPort::restart() {
 void EstimatorPort::add_sample(const ChainRecord& s) {
   // Settling samples and sequencing errors are the accumulator's to count;
   // the self-calibration takes the samples the accumulator took.
-  const est::WaveSample w = wave_sample(s);
+  const est::WaveSample w = wave_sample(s, damping_scale(s.wave.E_v2));
   if (est_.add_sample(w) == est::Status::ok) (void)self_cal_.add_sample(w);
 }
 
@@ -97,7 +99,7 @@ void EstimatorPort::add_control_sample(const ChainRecord& s) {
   if (s.t_s - last_control_t_s_ > kMaxControlGapS) est_.restart_control();
   last_control_t_s_ = s.t_s;
   // A bad sample restarts the estimate (the estimator's rule).
-  (void)est_.add_control_sample(control_sample(s));
+  (void)est_.add_control_sample(control_sample(s, damping_scale(s.wave.E_v2)));
 }
 
 double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {

@@ -226,7 +226,7 @@ void Gyro::task_output(Gyro& g) {
   // would add more error than it removes.
   g.check_model();
   const bool apply = g.cfg_.compensate_drift && g.status_.compensation_applied;
-  double drift = apply ? g.identifier_.drift_rad_s(o.theta_A_rad, ratio) : 0.0;
+  double drift = apply ? g.identifier_.drift_rad_s(o.theta_A_rad, ratio, o.wave.E_v2) : 0.0;
   // The control loops drift the pattern only while they drive it.
   double control = 0.0;
   if (apply && g.cfg_.compensate_control_drift && g.status_.excitation_on) {
@@ -278,6 +278,22 @@ void Gyro::restart_identification() {
   status_.compensation_valid = false;
 }
 
+void Gyro::task_temperature(Gyro& g) {
+  double temp_c = 0.0;
+  const hal::Status st = g.board_.temperature.read(temp_c);
+  GyroStatus& s = g.status_;
+  if (st == hal::Status::ok) {
+    s.temp_c = temp_c;
+    s.temp_valid = true;
+  } else if (!hal::is_retryable(st)) {
+    // A failed read is not a temperature: the model falls back to its
+    // reference temperature rather than use a stale one.
+    if (st != hal::Status::closed) ++s.temp_errors;
+    s.temp_valid = false;
+  }
+  g.identifier_.set_temperature_c(s.temp_c, s.temp_valid);
+}
+
 void Gyro::task_solve(Gyro& g) {
   if (g.cfg_.identify) g.identifier_.solve();
 }
@@ -304,6 +320,7 @@ void Gyro::task_telemetry(Gyro& g) {
   s.pump_v = st.chain.pump_v;
   s.row_pump_v = st.chain.pump_seen_v;
   s.agc_setpoint_v = g.cfg_.amplitude_set_v;
+  s.temp_c = st.temp_valid ? st.temp_c : 0.0;
   s.mode = st.mode;
   s.exc_on = st.excitation_on;
   s.exc_line = st.enable_line;

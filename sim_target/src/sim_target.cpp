@@ -12,7 +12,7 @@ namespace hrg::sim {
 
 using hal::Status;
 
-SimTarget::SimTarget() : board_{adc_, dac_, excitation_, fault_input_, can_, clock_} {
+SimTarget::SimTarget() : board_{adc_, dac_, excitation_, fault_input_, can_, clock_, temperature_} {
   configure(SimConfig{});
 }
 
@@ -49,6 +49,7 @@ void SimTarget::configure(const SimConfig& c) {
   last_pump_v_ = 0.0;
   counters_ = {};
   stage_times_ = {};
+  temperature_.reset(c.seed);
 }
 
 void SimTarget::set_rate_profile(Profile rate_rad_s) {
@@ -296,6 +297,28 @@ Status SimTarget::SimDac::write_block(std::span<const hal::q31_t> frames) {
     t->dac_queue_.push_back({frames[3 * k], frames[3 * k + 1], frames[3 * k + 2]});
   }
   t->dac_written_ = true;
+  return Status::ok;
+}
+
+void SimTarget::SimTemperature::reset(uint64_t seed) {
+  // Its own stream: reading the sensor leaves the pickoff noise's bits alone.
+  noise.reseed(seed ^ 0x7E3A5F0D1C2B4A69ull);
+  lagged_c = t->resonator_.temperature_c();
+  last_t_s = t->time_s();
+}
+
+Status SimTarget::SimTemperature::read(double& temp_c) {
+  const TemperatureSensorConfig& c = t->config_.temperature_sensor;
+  if (!c.present) return Status::closed;
+  const double now_s = t->time_s();
+  const double dt_s = now_s - last_t_s;
+  last_t_s = now_s;
+  // Exact first-order lag for a temperature held over the step.
+  const double true_c = t->resonator_.temperature_c();
+  lagged_c += (c.lag_s > 0.0 ? -std::expm1(-dt_s / c.lag_s) : 1.0) * (true_c - lagged_c);
+  double v = lagged_c + c.noise_c_rms * noise.normal();
+  if (c.lsb_c > 0.0) v = std::round(v / c.lsb_c) * c.lsb_c;
+  temp_c = v;
   return Status::ok;
 }
 

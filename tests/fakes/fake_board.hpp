@@ -110,6 +110,27 @@ class FakeDigitalIn final : public hal::DigitalIn {
   bool level_ = false;
 };
 
+// A temperature input whose reading and status the test sets (closed by
+// default: a board without a sensor).
+class FakeTemperature final : public hal::TemperatureSensor {
+ public:
+  hal::Status read(double& temp_c) override {
+    ++reads_;
+    if (status_ == hal::Status::ok) temp_c = temp_c_;
+    return status_;
+  }
+  void set(double temp_c, hal::Status st = hal::Status::ok) {
+    temp_c_ = temp_c;
+    status_ = st;
+  }
+  uint32_t reads() const { return reads_; }
+
+ private:
+  double temp_c_ = 0.0;
+  hal::Status status_ = hal::Status::closed;
+  uint32_t reads_ = 0;
+};
+
 // A whole board on the fakes, in lockstep.
 struct FakeBoard {
   FakeClock clock;
@@ -118,7 +139,8 @@ struct FakeBoard {
   FakeDigitalOut enable;
   FakeDigitalIn fault_in;
   FakeCan can;
-  hal::Board board{adc, dac, enable, fault_in, can, clock};
+  FakeTemperature temperature;
+  hal::Board board{adc, dac, enable, fault_in, can, clock, temperature};
   FakeBoard() { clock.set_lockstep(true); }
 };
 

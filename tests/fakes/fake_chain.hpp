@@ -84,12 +84,19 @@ class FakeResonatorIdentifier final : public fw::ResonatorIdentifier {
   void solve() override { ++solves; }
   fw::EstimatorHealth health() const override { return health_; }
   fw::Identification identification() const override { return {}; }
-  double drift_rad_s(double, double) const override { return drift; }
+  double drift_rad_s(double, double, double) const override { return drift; }
+  void set_temperature_c(double t_c, bool valid) override {
+    temp_c = t_c;
+    temp_valid = valid;
+    ++temperatures;
+  }
 
   fw::EstimatorHealth health_{};
   double drift = 0.0;
-  uint32_t begun = 0, ended = 0, aborted = 0, samples = 0, solves = 0;
+  uint32_t begun = 0, ended = 0, aborted = 0, samples = 0, solves = 0, temperatures = 0;
   double last_begin_s = 0.0;
+  double temp_c = 0.0;
+  bool temp_valid = false;
   bool open = false;
 };
 

@@ -125,6 +125,6 @@ TEST(FakeResonatorIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsIts
   DOUBLES_EQUAL(2.0, id.last_begin_s, 0.0);
   id.drift = 3e-4;
   id.health_ = {true, 12.0, 0.5};
-  DOUBLES_EQUAL(3e-4, id.drift_rad_s(0.1, 0.0), 0.0);
+  DOUBLES_EQUAL(3e-4, id.drift_rad_s(0.1, 0.0, 1.0), 0.0);
   DOUBLES_EQUAL(12.0, id.health().condition, 0.0);
 }

@@ -6,6 +6,7 @@
 // seam instead (no converter hardware needed).
 //   hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] [--seconds S]
 //             [--calibration FILE] [--converters sim|board] [--cal-secret HEX] [--lockstep]
+//             [--temp-path FILE]
 // The options set the board's environment (HRG_CAN_IF, HRG_GPIO_CHIP,
 // HRG_EXC_LINE, HRG_FAULT_LINE; the rest as hal/linux/board_linux.hpp says).
 // Without a GPIO chip (option or HRG_GPIO_CHIP) the simulated lines are used.
@@ -21,7 +22,11 @@
 // an audit-grade recording (hrg can-decode). --lockstep paces the firmware by
 // the simulated converters instead of CLOCK_MONOTONIC (an emulator or a slow
 // machine: nothing is missed, the bus carries the same frames sooner; the
-// recording's time is the firmware's, HRG_ROW.t_s).
+// recording's time is the firmware's, HRG_ROW.t_s). --temp-path FILE
+// (HRG_TEMP_PATH) is the resonator's temperature sensor, a file of
+// millidegrees C (IIO in_temp*_input, hwmon temp*_input); a file that does
+// not read as one stops the program naming it. Without it the simulated
+// converters bring the simulated sensor, board converters none.
 #include <signal.h>
 
 #include <array>
@@ -64,7 +69,7 @@ int usage() {
   std::fprintf(stderr,
                "usage: hrg-board --can IF [--gpio-chip CHIP --exc-line N --fault-line N] "
                "[--seconds S] [--calibration FILE] [--converters sim|board] [--cal-secret HEX] "
-               "[--lockstep]\n");
+               "[--lockstep] [--temp-path FILE]\n");
   return 2;
 }
 
@@ -87,6 +92,8 @@ bool parse(int argc, char** argv, Options& o) {
       setenv("HRG_EXC_LINE", v, 1);
     } else if (a == "--fault-line") {
       setenv("HRG_FAULT_LINE", v, 1);
+    } else if (a == "--temp-path") {
+      setenv("HRG_TEMP_PATH", v, 1);
     } else if (a == "--seconds") {
       o.seconds = std::atof(v);
     } else if (a == "--calibration") {
@@ -168,11 +175,17 @@ std::unique_ptr<hal::Board> assemble_board(const Options& o, hal::Board& sim) {
         env_or("HRG_DAC_DEV", "/dev/iio:device1"), hal::to_string(st.adc), hal::to_string(st.dac));
     return nullptr;
   }
+  const bool board_temp = std::getenv("HRG_TEMP_PATH") != nullptr;
+  if (board_temp && st.temperature != hal::Status::ok) {
+    std::fprintf(stderr, "hrg-board: %s\n", st.temperature_error);
+    return nullptr;
+  }
   const hal::Board& conv = o.board_converters ? hw : sim;
   const hal::Board& lines = board_lines ? hw : sim;
-  return std::make_unique<hal::Board>(hal::Board{conv.adc, conv.dac, lines.excitation_enable,
-                                                 lines.fault_input, hw.can,
-                                                 o.lockstep ? sim.clock : hw.clock});
+  const hal::Board& temp = board_temp || o.board_converters ? hw : sim;
+  return std::make_unique<hal::Board>(
+      hal::Board{conv.adc, conv.dac, lines.excitation_enable, lines.fault_input, hw.can,
+                 o.lockstep ? sim.clock : hw.clock, temp.temperature});
 }
 
 }  // namespace

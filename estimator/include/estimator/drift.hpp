@@ -34,6 +34,11 @@ namespace hrg::est {
 // measured a_B/a_A. rad/s in Omega K units. Any context.
 double resonator_drift_rad_s(const ParamVector& p, double theta_A_rad, double aB_over_aA);
 
+// p with its damping part (nu, dnu_C, dnu_S) multiplied by damping_scale:
+// a model identified at the reference state (WaveSample::damping_scale)
+// referred to the present temperature and amplitude. The split is kept.
+ParamVector with_damping_scale(const ParamVector& p, double damping_scale);
+
 // Integrates the modelled drift into an angle correction (input-axis radians).
 // Context: control-rate task. No heap.
 class DriftCompensator {
@@ -107,6 +112,7 @@ class ControlDriftEstimator {
     double quad_force_sin_v_s{0};    // quadrature forcer, part acting on a_B' (V/s)
     double quad_force_cos_v_s{0};    // quadrature forcer, part acting on the angle (V/s)
     double pump_v{0};                // ring-electrode pump amplitude V0 (V), for PumpDriftEstimator
+    double damping_scale{1};         // known factor on the damping now (WaveSample::damping_scale)
   };
 
   ControlDriftEstimator() = default;
@@ -129,7 +135,7 @@ class ControlDriftEstimator {
 
  private:
   struct Block {
-    double t{0}, aA{0}, aB{0}, c4{0}, s4{0}, tan_eps{0}, qs{0}, qc{0};
+    double t{0}, aA{0}, aB{0}, c4{0}, s4{0}, tan_eps{0}, qs{0}, qc{0}, k{0};
     int n{0};
   };
   Config config_{};

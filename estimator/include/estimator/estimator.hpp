@@ -82,9 +82,13 @@ class Estimator {
   // only if the solution is accepted (conditioning below the threshold).
   Solution solve_and_accept();
 
-  // D_nu + D_w (eqs. 6/7/22, drift.hpp) with the accepted model, rad/s ("Omega K" units).
-  double drift_rate_rad_s(double theta_A_rad, double aB_over_aA) const {
-    return has_model_ ? resonator_drift_rad_s(model_, theta_A_rad, aB_over_aA) : 0.0;
+  // D_nu + D_w (eqs. 6/7/22, drift.hpp) with the accepted model, rad/s ("Omega K" units),
+  // its damping referred to the present state by damping_scale (WaveSample::damping_scale).
+  double drift_rate_rad_s(double theta_A_rad, double aB_over_aA, double damping_scale = 1.0) const {
+    if (!has_model_) return 0.0;
+    return damping_scale == 1.0 ? resonator_drift_rad_s(model_, theta_A_rad, aB_over_aA)
+                                : resonator_drift_rad_s(with_damping_scale(model_, damping_scale),
+                                                        theta_A_rad, aB_over_aA);
   }
   // Feeds both D_Phi estimators (eq. 23 and the pump's gap part); false if
   // either refused the sample (it then restarts).

@@ -23,6 +23,12 @@ struct WaveSample {
   double a_B_v{0};        // quadrature wave amplitude, signed like Q = 2 a_A a_B
   double theta_A_rad{0};  // pattern angle (physical), any branch
   double E_v2{0};         // a_A^2 + a_B^2, computed from the quadratures (eq. 13)
+  // Known factor on the whole damping (mean and anisotropy) at this sample,
+  // relative to the resonator model's reference state: the calibration's
+  // thermal and nonlinear damping referred to the measured temperature and
+  // amplitude (docs/effects-catalog.md). The identified nu, dnu_C, dnu_S are
+  // then those of the reference state. 1: the seed's model (none known).
+  double damping_scale{1};
 };
 
 // p = (nu, dnu_C, dnu_S, dw_C, dw_S) of eq. 20, in this order.

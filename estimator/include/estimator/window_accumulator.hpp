@@ -20,6 +20,11 @@
 // the window's mean amplitude: the accumulated matrix is then the Fisher
 // information times sigma^2 (see NormalEquations::cramer_rao_bound).
 //
+// A known change of the whole damping with temperature or amplitude
+// (WaveSample::damping_scale k) enters the damping columns as k E, k P c4,
+// k P s4 and k a_A a_B, so the parameters are those of the reference state
+// and a common-damping change between windows is not taken for anisotropy.
+//
 // Rows are formed on blocks of `block_samples` consecutive samples (block
 // means), which cuts the cost of the rank-one updates by that factor and loses
 // a fraction (block/window)^2 of the information.

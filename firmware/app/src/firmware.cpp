@@ -14,6 +14,13 @@ bool is_identity_electronics(const Calibration& cal) {
          cal.feedthrough_y_im_v_per_v == 0.0;
 }
 
+// The resonator part: the estimator's regressors and drift use it.
+bool is_identity_resonator(const Calibration& cal) {
+  return cal.thermal_frequency_ppm_per_c == 0.0 && cal.thermal_damping_per_c == 0.0 &&
+         cal.duffing_hz_per_v2 == 0.0 && cal.electrostatic_spring_hz_per_v2 == 0.0 &&
+         cal.nonlinear_damping_per_v2 == 0.0;
+}
+
 bool significant(const est::PickoffSelfCalResult& r, double n_sigma) {
   return std::fabs(r.gain) > n_sigma * r.gain_sigma ||
          std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad;
@@ -33,8 +40,9 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
     return false;
   }
   cfg_.calibration = cal;
-  guard_.applied(source, calibration_crc(cal), identity, gyro_.status().chain.t_s,
-                 estimator_.health(), checking());
+  estimator_.set_resonator_model(cal);
+  guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
+                 gyro_.status().chain.t_s, estimator_.health(), checking());
   return true;
 }
 
@@ -71,6 +79,7 @@ void Firmware::judge_calibration() {
   // The chain goes back to the raw pickoffs; the verdict stays reported.
   chain_.clear_electronics_correction();
   cfg_.calibration = kIdentityCalibration;
+  estimator_.set_resonator_model(kIdentityCalibration);
 }
 
 }  // namespace hrg::fw::app

@@ -67,8 +67,17 @@ class ResonatorIdentifier {
   virtual EstimatorHealth health() const = 0;
   virtual Identification identification() const = 0;
   // Modelled drift D_nu + D_w (rad/s, Omega K units) at the current pattern
-  // angle and quadrature ratio (seed eq. 22); 0 while nothing is identified.
-  virtual double drift_rad_s(double theta_a_rad, double ab_over_aa) const = 0;
+  // angle and quadrature ratio (seed eq. 22), its damping referred to the
+  // wave's energy e_v2 = a_A^2 + a_B^2 (V^2) and the last measured
+  // temperature; 0 while nothing is identified.
+  virtual double drift_rad_s(double theta_a_rad, double ab_over_aa, double e_v2) const = 0;
+  // The resonator's temperature from the board's sensor (degC), at the
+  // temperature task's rate; `valid` false while the board has none (the
+  // resonator model is then taken at its reference temperature).
+  virtual void set_temperature_c(double temp_c, bool valid) {
+    (void)temp_c;
+    (void)valid;
+  }
   // Control-loop drift D_Phi (seed sections 6-7, eq. 23): fed with the
   // excitation on, added to the output only with the excitation on.
   virtual void add_control_sample(const ChainRecord& s) { (void)s; }

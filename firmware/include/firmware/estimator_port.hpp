@@ -3,6 +3,7 @@
 
 #include "estimator/estimator.hpp"
 #include "estimator/pickoff_self_calibration.hpp"
+#include "firmware/calibration.hpp"
 #include "firmware/chain_and_identifier.hpp"
 
 namespace hrg::fw {
@@ -22,8 +23,23 @@ class EstimatorPort final : public ResonatorIdentifier {
   void solve() override;
   EstimatorHealth health() const override { return health_; }
   Identification identification() const override;
-  double drift_rad_s(double theta_a_rad, double ab_over_aa) const override {
-    return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa);
+  double drift_rad_s(double theta_a_rad, double ab_over_aa, double e_v2) const override {
+    return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa, damping_scale(e_v2));
+  }
+  void set_temperature_c(double temp_c, bool valid) override {
+    temp_c_ = temp_c;
+    temp_valid_ = valid;
+  }
+  // The calibration's resonator model (thermal damping with its reference
+  // temperature, nonlinear damping) that the windows' regressors and the
+  // drift are referred to: the identified damping is the reference
+  // state's, so a known change of the common damping with temperature or
+  // amplitude is not taken for anisotropy. Call between windows.
+  void set_resonator_model(const Calibration& cal) { model_ = cal; }
+  // The known factor on the whole damping now, at energy e_v2 (V^2) and the
+  // measured temperature (the reference temperature without a sensor).
+  double damping_scale(double e_v2) const {
+    return fw::damping_scale(model_, temp_valid_ ? temp_c_ : model_.temperature_ref_c, e_v2);
   }
   void add_control_sample(const ChainRecord& s) override;
   double control_drift_rad_s(double theta_a_rad) const override;
@@ -44,6 +60,9 @@ class EstimatorPort final : public ResonatorIdentifier {
 
   est::Estimator::Config cfg_;
   est::Estimator est_;
+  Calibration model_{};  // its resonator part is used here
+  double temp_c_ = 0.0;
+  bool temp_valid_ = false;
   est::PickoffSelfCalibration self_cal_;
   est::PickoffSelfCalResult self_cal_result_{};
   EstimatorHealth health_{};

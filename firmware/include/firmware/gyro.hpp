@@ -76,6 +76,11 @@ struct GyroStatus {
   uint32_t adc_missed_blocks = 0;
   uint32_t dac_errors = 0;
   uint64_t adc_wait_ns = 0;  // timer time spent in Adc::read_block (lockstep: the simulation)
+  // The resonator's temperature as the board's sensor last read it (degC);
+  // temp_valid false while the board has none or its read fails.
+  double temp_c = 0.0;
+  bool temp_valid = false;
+  uint32_t temp_errors = 0;  // reads that failed (io_error etc.; `closed` is no sensor)
 };
 
 // The firmware: wires the HAL board, the signal chain and the identifier to
@@ -83,7 +88,7 @@ struct GyroStatus {
 // scheduler and the angle output. Everything is allocated at construction.
 class Gyro {
  public:
-  static constexpr std::size_t kTaskCount = 7;
+  static constexpr std::size_t kTaskCount = 8;
   // CAN command frames handled per command task run (the rest wait).
   static constexpr uint32_t kCommandsPerRun = 4;
   // Command task runs spent bus-off before the link restarts the CAN
@@ -146,6 +151,7 @@ class Gyro {
   static void task_supervise(Gyro& g);
   static void task_identify(Gyro& g);
   static void task_output(Gyro& g);
+  static void task_temperature(Gyro& g);
   static void task_solve(Gyro& g);
   static void task_telemetry(Gyro& g);
   static void task_commands(Gyro& g);
@@ -201,13 +207,16 @@ class Gyro {
 // The task table. The fast chain first (ADC -> demod -> PLL/AGC/quadrature ->
 // DAC): the DAC block written in this frame is output one block later, so
 // anything before it would add a frame of latency to the loops. Then decide
-// (supervise), then use the fresh sample (identify, output); the slow tasks last.
+// (supervise), then use the fresh sample (identify, output); the slow tasks last
+// (the temperature sensor at 10 Hz: the resonator's temperature moves over
+// seconds, and a sensor read may be a bus transaction).
 inline constexpr std::array<Task<Gyro>, Gyro::kTaskCount> kGyroTasks{{
     // name        function                 rate_hz      budget_ns
     {"chain", &Gyro::task_chain, kBaseRateHz, 400'000},
     {"supervise", &Gyro::task_supervise, kBaseRateHz, 40'000},
     {"identify", &Gyro::task_identify, kBaseRateHz, 40'000},
     {"output", &Gyro::task_output, kBaseRateHz, 20'000},
+    {"temperature", &Gyro::task_temperature, 100, 10'000},
     {"solve", &Gyro::task_solve, 10, 200'000},
     {"telemetry", &Gyro::task_telemetry, kBaseRateHz, 60'000},
     {"commands", &Gyro::task_commands, 100, 30'000},

@@ -5,6 +5,7 @@
 #include "hal/clock.hpp"
 #include "hal/converters.hpp"
 #include "hal/gpio.hpp"
+#include "hal/temperature.hpp"
 
 namespace hrg::hal {
 
@@ -17,6 +18,7 @@ struct Board {
   DigitalIn& fault_input;
   CanBus& can;
   MonotonicClock& clock;
+  TemperatureSensor& temperature;  // NoTemperatureSensor when the board has none
 };
 
 Board& board();

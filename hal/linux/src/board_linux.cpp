@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "hal/linux/file_temperature.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/linux_clock.hpp"
 #include "hal/linux/socket_can.hpp"
@@ -41,8 +42,9 @@ struct LinuxBoard {
   StreamAdc adc;
   StreamDac dac;
   LinuxClock clock;
+  FileTemperatureSensor temperature;
   BoardOpenStatus status;
-  Board board{adc, dac, excitation, fault, can, clock};
+  Board board{adc, dac, excitation, fault, can, clock, temperature};
 
   LinuxBoard() {
     status.can = can.open(env_or("HRG_CAN_IF", "can0"));
@@ -68,6 +70,10 @@ struct LinuxBoard {
       status.dac = dac.open(env_or("HRG_DAC_DEV", "/dev/iio:device1"), dac_cfg);
     } else {
       status.adc = status.dac = Status::invalid_argument;
+    }
+    if (const char* temp_path = env_or("HRG_TEMP_PATH", nullptr)) {
+      status.temperature = temperature.open(temp_path);
+      status.temperature_error = temperature.error();
     }
   }
 };

@@ -126,6 +126,17 @@ class SimTarget {
     uint64_t now_ns() const override;
     hal::Status sleep_until_ns(uint64_t t_ns) override;
   };
+  // The temperature sensor of TemperatureSensorConfig: reads the
+  // resonator's temperature at the simulated time of the call.
+  struct SimTemperature final : hal::TemperatureSensor {
+    SimTarget* t;
+    explicit SimTemperature(SimTarget* owner) : t(owner) {}
+    hal::Status read(double& temp_c) override;
+    void reset(uint64_t seed);
+    detail::Gaussian noise;
+    double lagged_c = 0.0;
+    double last_t_s = 0.0;
+  };
   using DacFrame = std::array<hal::q31_t, hal::kDacChannels>;
 
   // A block is produced in chunks of at most kChunk samples through fixed
@@ -166,6 +177,7 @@ class SimTarget {
   SimExcitation excitation_;
   SimFaultIn fault_input_;
   SimClock clock_{this};
+  SimTemperature temperature_{this};
   hal::Board board_;
 
   uint64_t sample_index_ = 0;

@@ -36,6 +36,20 @@ struct CanConfig {
   uint32_t tx_frames_per_ms = 8;  // frames leaving the queue per millisecond (about 1 Mbit/s)
 };
 
+// The board's temperature sensor (hal::TemperatureSensor): what the firmware
+// reads of the resonator's temperature. A digital sensor quantised to its
+// resolution (2^-7 degC: a 16-bit part at 128 LSB/degC). Neither the
+// catalogue nor the resonator model has a sensor noise or a thermal lag
+// between the resonator and the sensor, so both are off by default; set,
+// the reading lags the resonator's temperature (first order) and gains white
+// noise per conversion.
+struct TemperatureSensorConfig {
+  bool present = true;
+  double lsb_c = 0.0078125;  // resolution; 0: not quantised
+  double lag_s = 0.0;        // time constant behind the resonator's temperature
+  double noise_c_rms = 0.0;  // per conversion
+};
+
 // Resonator state at t = 0.
 struct InitialWave {
   double amplitude_v = 0.0;  // a_A
@@ -50,6 +64,7 @@ struct SimConfig {
   AdcConfig adc;
   DacConfig dac;
   CanConfig can;
+  TemperatureSensorConfig temperature_sensor;
   Profile rate_rad_s = Profile::constant(0.0);
   Profile temp_c = Profile::constant(25.0);
   InitialWave initial;

@@ -50,7 +50,8 @@ struct Rig {
   hal::linux_board::LinuxClock rt_clock;
   hal::Board& sim_board;
   hal::Board rt_board{sim_board.adc,         sim_board.dac, sim_board.excitation_enable,
-                      sim_board.fault_input, sim_board.can, rt_clock};
+                      sim_board.fault_input, sim_board.can, rt_clock,
+                      sim_board.temperature};
 };
 
 std::unique_ptr<fw::app::Firmware> build_firmware(const RunConfig& job, Rig& rig,
@@ -232,7 +233,10 @@ void record_row(RunResult& r, const RunConfig& job, const fw::Gyro& g, const Row
   row.exc = stamp.drive_free() ? 0 : 1;
   row.excitation_cmd = st.excitation_on ? 1 : 0;
   row.pump_v = ch.pump_seen_v;  // the pump the row's quadratures saw
-  row.temp_c = ts.temp_c;
+  // The temperature the firmware measured (the board's sensor, with its
+  // resolution, noise and lag), as a gyro's own recording carries it; the
+  // true one only when the board has no sensor.
+  row.temp_c = st.temp_valid ? st.temp_c : ts.temp_c;
   row.rate_dps = ts.rate_rad_s / kDeg;
   row.pll_hz = ch.pll_freq_hz;
   row.quad_v = ch.wave.a_B_v;

@@ -54,8 +54,8 @@ class ConvergenceProbe {
     const fw::EstimatorPort& est = firmware.estimator();
     double e_c = truth_[1], e_s = truth_[2];
     if (firmware.gyro().status().compensation_applied) {
-      e_c -= est.drift_rad_s(kPi / 8.0, 0.0);
-      e_s += est.drift_rad_s(0.0, 0.0);
+      e_c -= est.drift_rad_s(kPi / 8.0, 0.0, 0.0);
+      e_s += est.drift_rad_s(0.0, 0.0, 0.0);
     }
     out_.model_adb_dph.push_back(std::hypot(e_c, e_s) / k_ * kRadSToDph);
     const est::ParamMatrix crb = est.estimator().cramer_rao_bound(1.0);

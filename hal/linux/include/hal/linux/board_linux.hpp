@@ -19,6 +19,9 @@ namespace hrg::hal::linux_board {
 //   HRG_ADC_FULL_SCALE_V, HRG_DAC_FULL_SCALE_V  volts at Q1.31 full scale (2.5, 10)
 //   HRG_SAMPLE_RATE_HZ    converter rate                 (100000)
 //   HRG_BLOCK_FRAMES      frames per block               (100)
+//   HRG_TEMP_PATH         resonator temperature, a file of millidegrees C
+//                         (IIO in_temp*_input, hwmon temp*_input); unset: no
+//                         sensor (the temperature input reads `closed`)
 // A device that does not open leaves its object closed: every call on it
 // returns Status::closed, and board_open_status() says which and why.
 struct BoardOpenStatus {
@@ -27,6 +30,8 @@ struct BoardOpenStatus {
   Status fault = Status::closed;
   Status adc = Status::closed;
   Status dac = Status::closed;
+  Status temperature = Status::closed;
+  const char* temperature_error = "";  // why the temperature file was refused (path named)
 };
 BoardOpenStatus board_open_status();
 
