@@ -313,3 +313,36 @@ TEST(Gyro, CanCommandsSetTheAgcSetPointAndTheWindowTiming) {
   LONGS_EQUAL(2000, g.scheduler().config().period_frames);
   LONGS_EQUAL(250, g.scheduler().config().length_frames);
 }
+
+TEST(Gyro, ReadsTheTemperatureSensorAt100HzAndPassesItToTheIdentifierAndTelemetry) {
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, test_config());
+  // GIVEN a board without a sensor: no temperature, nothing counted as an error
+  run(g, 1000);
+  LONGS_EQUAL(100, b.temperature.reads());
+  CHECK_FALSE(g.status().temp_valid);
+  CHECK_FALSE(ident.temp_valid);
+  LONGS_EQUAL(0, g.status().temp_errors);
+  // WHEN the sensor reads 26.5 degC
+  b.temperature.set(26.5);
+  run(g, 100);
+  // THEN the firmware reports it and the identifier refers its model to it
+  CHECK(g.status().temp_valid);
+  DOUBLES_EQUAL(26.5, g.status().temp_c, 0.0);
+  DOUBLES_EQUAL(26.5, ident.temp_c, 0.0);
+  CHECK(ident.temp_valid);
+  DOUBLES_EQUAL(26.5, g.telemetry().temp_c, 0.0);
+  // WHEN a read fails, the value is no longer used (the model's reference
+  // temperature is, not a stale reading) and the failure is counted
+  b.temperature.set(99.0, hrg::hal::Status::io_error);
+  run(g, 10);
+  CHECK_FALSE(g.status().temp_valid);
+  CHECK_FALSE(ident.temp_valid);
+  LONGS_EQUAL(1, g.status().temp_errors);
+  // WHEN it only has no new conversion yet, the last reading stays
+  b.temperature.set(27.0);
+  run(g, 10);
+  b.temperature.set(0.0, hrg::hal::Status::would_block);
+  run(g, 10);
+  CHECK(g.status().temp_valid);
+  DOUBLES_EQUAL(27.0, ident.temp_c, 0.0);
+}

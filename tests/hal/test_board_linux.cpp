@@ -27,12 +27,17 @@ namespace {
 struct Fixture {
   std::string adc_path;
   std::string dac_path;
+  std::string temp_path;
   int adc_writer = -1;
   int dac_reader = -1;
   Fixture() {
     const std::string base = "/tmp/hrg-board-test-" + std::to_string(::getpid());
     adc_path = base + "-adc";
     dac_path = base + "-dac";
+    temp_path = base + "-temp1_input";
+    const int temp_fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    (void)::write(temp_fd, "31250\n", 6);
+    ::close(temp_fd);
     ::mkfifo(adc_path.c_str(), 0600);
     ::mkfifo(dac_path.c_str(), 0600);
     dac_reader = ::open(dac_path.c_str(), O_RDONLY | O_NONBLOCK);  // so the DAC can open
@@ -44,6 +49,7 @@ struct Fixture {
     ::setenv("HRG_DAC_FORMAT", "le:s16/16>>0", 1);
     ::setenv("HRG_BLOCK_FRAMES", "4", 1);
     ::setenv("HRG_ADC_FULL_SCALE_V", "3.3", 1);
+    ::setenv("HRG_TEMP_PATH", temp_path.c_str(), 1);
     (void)board();
     adc_writer = ::open(adc_path.c_str(), O_WRONLY | O_NONBLOCK);
   }
@@ -52,6 +58,7 @@ struct Fixture {
     ::close(dac_reader);
     ::unlink(adc_path.c_str());
     ::unlink(dac_path.c_str());
+    ::unlink(temp_path.c_str());
   }
 };
 Fixture fixture;
@@ -72,6 +79,15 @@ TEST(LinuxBoard, DevicesThatDoNotOpenAreClosedAndSaySo) {
   CHECK(Status::closed == board().excitation_enable.write(true));
   bool v = false;
   CHECK(Status::closed == board().fault_input.read(v));
+}
+
+TEST(LinuxBoard, TheTemperatureComesFromTheFileNamedByHrgTempPath) {
+  const BoardOpenStatus s = board_open_status();
+  CHECK(Status::ok == s.temperature);
+  STRCMP_EQUAL("", s.temperature_error);
+  double t = 0.0;
+  CHECK(Status::ok == board().temperature.read(t));
+  DOUBLES_EQUAL(31.25, t, 1e-12);
 }
 
 TEST(LinuxBoard, TheAdcStreamIsReadInItsIioFormat) {
