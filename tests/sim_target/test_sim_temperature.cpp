@@ -30,13 +30,17 @@ TEST_GROUP(SimTemperature){};
 TEST(SimTemperature, ReadsTheResonatorTemperatureQuantisedToTheSensorResolution) {
   SimTarget t;
   SimConfig c;
-  c.temp_c = Profile::constant(25.3);
+  c.temp_c = Profile::constant(25.3004);
   t.configure(c);
   double v = 0.0;
+  // At the default millidegree: 25300.4 mdegC -> 25300 mdegC
   CHECK(t.board().temperature.read(v) == hal::Status::ok);
-  // 25.3 / 2^-7 = 3238.4 LSB -> 3238 LSB = 25.296875 degC
+  DOUBLES_EQUAL(25.3, v, 1e-12);
+  // A 16-bit part at 2^-7 degC: 3238.45 LSB -> 3238 LSB = 25.296875 degC
+  c.temperature_sensor.lsb_c = 0.0078125;
+  t.configure(c);
+  CHECK(t.board().temperature.read(v) == hal::Status::ok);
   DOUBLES_EQUAL(25.296875, v, 0.0);
-  DOUBLES_EQUAL(std::round(25.3 / c.temperature_sensor.lsb_c) * c.temperature_sensor.lsb_c, v, 0.0);
 }
 
 TEST(SimTemperature, ABoardWithoutTheSensorReadsClosed) {

@@ -37,15 +37,18 @@ struct CanConfig {
 };
 
 // The board's temperature sensor (hal::TemperatureSensor): what the firmware
-// reads of the resonator's temperature. A digital sensor quantised to its
-// resolution (2^-7 degC: a 16-bit part at 128 LSB/degC). Neither the
+// reads of the resonator's temperature, quantised to the millidegree that the
+// Linux interfaces (IIO in_temp*_input, hwmon temp*_input) carry. Neither the
 // catalogue nor the resonator model has a sensor noise or a thermal lag
-// between the resonator and the sensor, so both are off by default; set,
-// the reading lags the resonator's temperature (first order) and gains white
-// noise per conversion.
+// between the resonator and the sensor, so both are off by default; set, the
+// reading lags the resonator's temperature (first order) and gains white
+// noise per conversion. A coarser part (2^-7 degC, lsb_c 0.0078125) leaves a
+// quantisation error that the audit's frequency model integrates into the
+// phase: on a +-1 degC, 5 ppm/degC recording it then also reports a 0.026 deg
+// pickoff phase mismatch (6 sigma) that is not there.
 struct TemperatureSensorConfig {
   bool present = true;
-  double lsb_c = 0.0078125;  // resolution; 0: not quantised
+  double lsb_c = 0.001;      // resolution, degC; 0: not quantised
   double lag_s = 0.0;        // time constant behind the resonator's temperature
   double noise_c_rms = 0.0;  // per conversion
 };
