@@ -215,11 +215,7 @@ uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
     }
     return clipped;
   }
-  for (std::size_t i = 0; i < 2 * n; ++i) {
-    bool clip = false;
-    out[i] = adc_q_.convert(volts_[i], clip);
-    clipped += clip ? 1u : 0u;
-  }
+  clipped = adc_q_.convert_block(volts_.data(), out, 2 * n);
   if (n > 0) adc_last_ = {out[2 * n - 2], out[2 * n - 1]};  // what a stuck channel holds
   return clipped;
 }
