@@ -120,18 +120,32 @@ class Gaussian {
 
   // Pass 1: the lanes' next kBlock / kLanes outputs each, interleaved.
   void draw_raw() {
+    // The state in locals: the compiler need not assume raw_ aliases it.
+    uint64_t s0[kLanes], s1[kLanes], s2[kLanes], s3[kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      s0[l] = lanes_[0][l];
+      s1[l] = lanes_[1][l];
+      s2[l] = lanes_[2][l];
+      s3[l] = lanes_[3][l];
+    }
     for (std::size_t k = 0; k < kBlock; k += kLanes) {
       for (std::size_t l = 0; l < kLanes; ++l) {
-        const uint64_t s1 = lanes_[1][l];
-        raw_[k + l] = rotl((s1 << 2) + s1, 7) * 9;  // s1 * 5, as shifts for the vector unit
-        const uint64_t t = s1 << 17;
-        lanes_[2][l] ^= lanes_[0][l];
-        lanes_[3][l] ^= s1;
-        lanes_[1][l] = s1 ^ lanes_[2][l];
-        lanes_[0][l] ^= lanes_[3][l];
-        lanes_[2][l] ^= t;
-        lanes_[3][l] = rotl(lanes_[3][l], 45);
+        const uint64_t a = rotl((s1[l] << 2) + s1[l], 7);  // s1 * 5, as shifts for the vector unit
+        raw_[k + l] = (a << 3) + a;                        // * 9
+        const uint64_t t = s1[l] << 17;
+        s2[l] ^= s0[l];
+        s3[l] ^= s1[l];
+        s1[l] ^= s2[l];
+        s0[l] ^= s3[l];
+        s2[l] ^= t;
+        s3[l] = rotl(s3[l], 45);
       }
+    }
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      lanes_[0][l] = s0[l];
+      lanes_[1][l] = s1[l];
+      lanes_[2][l] = s2[l];
+      lanes_[3][l] = s3[l];
     }
   }
 
