@@ -25,7 +25,7 @@ TEST(Gaussian, MomentsTailsAndHistogramAreTheNormalOnes) {
   g.fill(x.data(), kN);
   const double n = static_cast<double>(kN);
   double m1 = 0, m2 = 0, m4 = 0;
-  double lag[9] = {};  // lags 1-8: the draws come from 4 streams side by side
+  double lag[9] = {};  // lags 1-8
   std::size_t beyond2 = 0, beyond3 = 0, beyond4 = 0;
   constexpr int kBins = 40;  // width 0.25 over [-5, 5)
   std::vector<double> hist(kBins, 0.0);
