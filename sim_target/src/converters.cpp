@@ -18,6 +18,8 @@ AdcQuantizer::AdcQuantizer(const AdcConfig& c)
     : bits_(checked_bits(c.bits)),
       full_scale_v_(c.full_scale_v),
       lsb_v_(c.full_scale_v / std::ldexp(1.0, static_cast<int>(c.bits) - 1)),
+      inv_lsb_(1.0 / lsb_v_),
+      inverse_exact_(std::isnormal(lsb_v_) && std::isnormal(inv_lsb_)),
       code_max_((int64_t{1} << (c.bits - 1)) - 1) {}
 
 double AdcQuantizer::to_volts(hal::q31_t word) const {

@@ -116,23 +116,23 @@ void SimTarget::fill_drives(std::size_t m) {
   // Double buffer: the frames the firmware queued, then zeros when none is
   // waiting (an underrun once the firmware has written).
   const std::size_t queued = std::min(dac_queue_.size() - dac_head_, m);
-  const DacFrame* from_queue = dac_queue_.data() + dac_head_;
   if (queued < m && dac_written_) counters_.dac_underruns += m - queued;
-  const std::size_t latency = dac_latency_.size();
-  const bool on = excitation_.value;
+  std::copy_n(dac_queue_.data() + dac_head_, queued, frames_.begin());
+  std::fill_n(frames_.begin() + static_cast<std::ptrdiff_t>(queued), m - queued, DacFrame{});
+  if (!dac_latency_.empty()) delay_frames(m);
+  // A channel is gated off (0 V) while the excitation is off or it is dead;
+  // its codes still count at the rails.
+  std::array<bool, hal::kDacChannels> live{};
+  for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch)
+    live[ch] = excitation_.value && !dac_dead_[ch];
   uint64_t saturated = 0;
   for (std::size_t k = 0; k < m; ++k) {
-    DacFrame frame = k < queued ? from_queue[k] : DacFrame{};
-    if (latency != 0) {
-      std::swap(frame, dac_latency_[latency_pos_]);
-      if (++latency_pos_ == latency) latency_pos_ = 0;
-    }
     std::array<double, hal::kDacChannels> v{};
     for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
       bool rail = false;
-      v[ch] = dac_q_.convert(frame[ch], rail);
+      const double volts = dac_q_.convert(frames_[k][ch], rail);
       saturated += rail ? 1 : 0;
-      if (dac_dead_[ch] || !on) v[ch] = 0.0;
+      v[ch] = live[ch] ? volts : 0.0;
     }
     drives_[k] = Drive{v[0], v[1], v[2]};
   }
@@ -141,6 +141,14 @@ void SimTarget::fill_drives(std::size_t m) {
   if (dac_head_ == dac_queue_.size()) {
     dac_queue_.clear();
     dac_head_ = 0;
+  }
+}
+
+void SimTarget::delay_frames(std::size_t m) {
+  const std::size_t latency = dac_latency_.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    std::swap(frames_[k], dac_latency_[latency_pos_]);
+    if (++latency_pos_ == latency) latency_pos_ = 0;
   }
 }
 
@@ -176,30 +184,17 @@ void SimTarget::run_resonator(std::size_t n, double dt) {
   });
 }
 
-uint32_t SimTarget::run_fused(std::size_t n, double dt, hal::q31_t* out) {
-  const double offset_x = config_.adc.offset_v[0];
-  const double offset_y = config_.adc.offset_v[1];
-  const auto& rms = config_.adc.noise_v_rms;
-  const bool noisy = rms[0] != 0.0 || rms[1] != 0.0;
-  uint32_t clipped = 0;
-  // The noise draws in the order fill() gives them (x, y per sample).
-  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
-    double x_v = p.x_v + offset_x;
-    double y_v = p.y_v + offset_y;
-    if (noisy) {
-      x_v += rms[0] * noise_.normal();
-      y_v += rms[1] * noise_.normal();
-    }
-    clipped += quantize_sample(0, x_v, out[2 * k]);
-    clipped += quantize_sample(1, y_v, out[2 * k + 1]);
-  });
-  return clipped;
-}
-
 void SimTarget::add_noise(std::size_t n, double dt) {
   const auto& rms = config_.adc.noise_v_rms;
   if (rms[0] == 0.0 && rms[1] == 0.0 && !(burst_left_s_ > 0.0)) return;
   noise_.fill(noise_buf_.data(), 2 * n);
+  if (!(burst_left_s_ > 0.0)) {
+    for (std::size_t k = 0; k < n; ++k) {
+      volts_[2 * k] += rms[0] * noise_buf_[2 * k];
+      volts_[2 * k + 1] += rms[1] * noise_buf_[2 * k + 1];
+    }
+    return;
+  }
   // hypot only while a burst is on (it may end within the chunk).
   std::array<double, 2> burst_rms = rms;
   if (burst_left_s_ > 0.0)
@@ -214,10 +209,15 @@ void SimTarget::add_noise(std::size_t n, double dt) {
 
 uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
   uint32_t clipped = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch)
-      clipped += quantize_sample(ch, volts_[2 * k + ch], out[2 * k + ch]);
+  if (adc_stuck_[0] || adc_stuck_[1] || adc_saturated_[0] || adc_saturated_[1]) {
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t ch = 0; ch < hal::kAdcChannels; ++ch)
+        clipped += quantize_sample(ch, volts_[2 * k + ch], out[2 * k + ch]);
+    }
+    return clipped;
   }
+  clipped = adc_q_.convert_block(volts_.data(), out, 2 * n);
+  if (n > 0) adc_last_ = {out[2 * n - 2], out[2 * n - 1]};  // what a stuck channel holds
   return clipped;
 }
 
@@ -234,19 +234,11 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   clipped = 0;
   // In chunks of kChunk samples: the DAC's drives, then the resonator
   // (pickoffs at t_k, then one step under drive k), the pickoff noise and
-  // the ADC. Without a noise burst or profiling the last three run in one
-  // loop, where the noise and the ADC overlap the step's dependency chain;
-  // otherwise stage by stage, to time each stage. Both give sample k the
-  // same inputs and the same bits.
+  // the ADC, stage by stage: each stage is a tight loop over the chunk.
   for (std::size_t done = 0; done < n; done += kChunk) {
     const std::size_t m = std::min<std::size_t>(kChunk, n - done);
     fill_drives(m);
     last_pump_v_ = drives_[m - 1].pump_v;
-    if (!profiling_ && !(burst_left_s_ > 0.0)) {
-      clipped += run_fused(m, dt, frames.data() + 2 * done);
-      sample_index_ += m;
-      continue;
-    }
     laps.lap(&SimStageTimes::dac_ns);
     run_resonator(m, dt);
     sample_index_ += m;

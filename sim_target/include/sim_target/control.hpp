@@ -147,8 +147,6 @@ class SimTarget {
   void run_resonator(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   uint32_t quantize(std::size_t n, hal::q31_t* out);
-  // Resonator, noise and ADC in one loop (no burst on); returns the clipped count.
-  uint32_t run_fused(std::size_t n, double dt, hal::q31_t* out);
   // One ADC conversion with the channel's faults; 1 when it clipped.
   uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {
     bool clip = false;
@@ -164,6 +162,8 @@ class SimTarget {
   }
   // drives_[0..m): the DAC's next m frames through its latency line and quantisers.
   void fill_drives(std::size_t m);
+  // frames_[0..m) through the DAC's latency line (ring).
+  void delay_frames(std::size_t m);
   uint64_t sample_time_ns(uint64_t index) const;
 
   SimConfig config_;
@@ -201,6 +201,7 @@ class SimTarget {
   SimCounters counters_;
   bool profiling_ = false;
   SimStageTimes stage_times_;
+  std::array<DacFrame, kChunk> frames_{};
   std::array<Drive, kChunk> drives_{};
   std::array<double, 2 * kChunk> volts_{};
   std::array<double, 2 * kChunk> noise_buf_{};

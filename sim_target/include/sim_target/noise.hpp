@@ -12,8 +12,15 @@
 // beyond r = 3.4426 take an exp or a log). The distribution is exactly the
 // normal one: the layers are accepted or rejected against the density itself.
 // One draw feeds both the layer (its low 7 bits) and the abscissa (its top 53
-// bits), which do not overlap. fill() draws a block.
+// bits), which do not overlap.
+//
+// Draws are made in blocks of kBlock into a buffer that normal() and fill()
+// hand out in turn: the generator's state stays in registers over a block
+// and the consumer pays a load per normal. The sequence is the one the
+// ziggurat gives draw by draw (buffering changes when a normal is computed,
+// not which one), so block boundaries and call patterns do not change bits.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -26,6 +33,7 @@ class Gaussian {
   explicit Gaussian(uint64_t seed = 1) { reseed(seed); }
 
   void reseed(uint64_t seed) {
+    pos_ = kBlock;  // the buffer is refilled from the new state
     for (auto& s : s_) {
       seed += 0x9E3779B97F4A7C15ull;
       uint64_t z = seed;
@@ -39,28 +47,24 @@ class Gaussian {
   double uniform() { return to_unit(next()); }
 
   double normal() {
-    const Layers& z = layers();
-    for (;;) {
-      const uint64_t r = next();
-      const double u = 2.0 * to_unit(r) - 1.0;  // (-1, 1)
-      const auto i = static_cast<std::size_t>(r & (kLayers - 1));
-      if (std::fabs(u) < z.ratio[i]) return u * z.x[i];  // inside the layer's rectangle
-      if (i == 0) return tail(u < 0.0);
-      // The wedge between the rectangle and the density: accept against f itself.
-      const double x = u * z.x[i];
-      const double f0 = std::exp(-0.5 * (z.x[i] * z.x[i] - x * x));
-      const double f1 = std::exp(-0.5 * (z.x[i + 1] * z.x[i + 1] - x * x));
-      if (f1 + uniform() * (f0 - f1) < 1.0) return x;
-    }
+    if (pos_ == kBlock) refill();
+    return buf_[pos_++];
   }
 
   // n normals into out, in the order normal() would give them.
   void fill(double* out, std::size_t n) {
-    for (std::size_t k = 0; k < n; ++k)
-      out[k] = normal();
+    while (n > 0) {
+      if (pos_ == kBlock) refill();
+      const std::size_t take = std::min(n, kBlock - pos_);
+      std::copy_n(buf_.data() + pos_, take, out);
+      pos_ += take;
+      out += take;
+      n -= take;
+    }
   }
 
  private:
+  static constexpr std::size_t kBlock = 256;  // normals per refill
   static constexpr std::size_t kLayers = 128;
   static constexpr double kTailStart = 3.442619855899;       // r: where the tail begins
   static constexpr double kLayerArea = 9.91256303526217e-3;  // area of each layer
@@ -86,6 +90,29 @@ class Gaussian {
   static const Layers& layers() {
     static const Layers z;
     return z;
+  }
+
+  // One normal by the ziggurat.
+  double draw(const Layers& z) {
+    for (;;) {
+      const uint64_t r = next();
+      const double u = 2.0 * to_unit(r) - 1.0;  // (-1, 1)
+      const auto i = static_cast<std::size_t>(r & (kLayers - 1));
+      if (std::fabs(u) < z.ratio[i]) return u * z.x[i];  // inside the layer's rectangle
+      if (i == 0) return tail(u < 0.0);
+      // The wedge between the rectangle and the density: accept against f itself.
+      const double x = u * z.x[i];
+      const double f0 = std::exp(-0.5 * (z.x[i] * z.x[i] - x * x));
+      const double f1 = std::exp(-0.5 * (z.x[i + 1] * z.x[i + 1] - x * x));
+      if (f1 + uniform() * (f0 - f1) < 1.0) return x;
+    }
+  }
+
+  void refill() {
+    const Layers& z = layers();
+    for (auto& v : buf_)
+      v = draw(z);
+    pos_ = 0;
   }
 
   // Marsaglia's tail beyond r: exact, by rejection from an exponential.
@@ -114,6 +141,8 @@ class Gaussian {
   }
 
   uint64_t s_[4]{};
+  std::array<double, kBlock> buf_{};
+  std::size_t pos_ = kBlock;
 };
 
 }  // namespace hrg::sim::detail
