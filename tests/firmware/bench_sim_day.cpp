@@ -187,6 +187,12 @@ int main(int argc, char** argv) {
   sim_run::RunResult r = sim_run::run_simulation(job, opt);
   const bool passed = sim_run::judge(job, r);
   print_convergence(hours);
+  for (const auto& p : r.parks) {
+    std::printf("  park %7.2f deg  raw %+9.3f  compensated %+8.4f  truth %+9.3f deg/h%s\n",
+                p.theta_rad * 180.0 / std::numbers::pi, p.bias_raw_dph, p.bias_comp_dph,
+                p.bias_model_dph, p.model_valid ? "" : "  (model not valid)");
+  }
+  std::printf("control-loop drift added: mean %+.4f deg/h\n", r.control_drift_mean_dph);
   const bool written = write_csv(o.csv, hours);
   std::printf(
       "parked-angle test (%zu parks, %zu with the model valid): raw ADB %.3f, compensated "
