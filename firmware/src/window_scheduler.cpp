@@ -50,34 +50,39 @@ double WindowScheduler::excitation_off_fraction() const {
   return frames_ == 0 ? 0.0 : static_cast<double>(off_frames_) / static_cast<double>(frames_);
 }
 
-void WindowScheduler::open(uint32_t bin, WindowDecision& d) {
+void WindowScheduler::open(uint32_t bin, uint32_t length_frames, WindowDecision& d) {
   d.open = true;
   in_window_ = true;
   in_window_frames_ = 0;
-  window_length_ = done_ ? operation_length() : cfg_.length_frames;
+  window_length_ = length_frames;
   window_bin_ = bin;
   since_start_ = 0;
   moving_ = false;
 }
 
-bool WindowScheduler::operation_window_due(bool is_static) const {
+uint32_t WindowScheduler::operation_window_due(bool is_static) const {
+  // Continued identification first: as many windows as the duty allows,
+  // never closer than the window period. They are the long ones (their
+  // decay information grows as the length cubed), and each is also a check.
+  if (cfg_.operation_duty > 0.0 && since_start_ >= cfg_.period_frames) {
+    const double off_after = static_cast<double>(off_frames_ + operation_length());
+    if (off_after <= cfg_.operation_duty * static_cast<double>(frames_ + operation_length())) {
+      return operation_length();
+    }
+  }
   // Check windows: the model in force is tested against new free decays
   // (at whatever turn rate and temperature the gyro now sees) at least every
   // check period, and the first time the base has been still for a window
   // period, at once (what a fit on a turning base absorbs shows on a still
   // one).
   if (cfg_.check_period_frames != 0) {
-    if (since_start_ >= cfg_.check_period_frames) return true;
+    if (since_start_ >= cfg_.check_period_frames) return check_length();
     if (!static_checked_ && is_static && static_frames_ >= cfg_.period_frames &&
         since_start_ >= cfg_.period_frames) {
-      return true;
+      return check_length();
     }
   }
-  // Continued identification: as many windows as the duty allows, never
-  // closer than the window period.
-  if (cfg_.operation_duty <= 0.0 || since_start_ < cfg_.period_frames) return false;
-  const double off_after = static_cast<double>(off_frames_ + operation_length());
-  return off_after <= cfg_.operation_duty * static_cast<double>(frames_ + operation_length());
+  return 0;
 }
 
 WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_rate_rad_s,
@@ -118,8 +123,9 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
       // In operation: check and continued-identification windows.
       const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
       static_frames_ = is_static ? static_frames_ + 1 : 0;
-      if (mode == Mode::operate && operation_window_due(is_static)) {
-        open(bin_of(theta_rad), d);
+      const uint32_t length = mode == Mode::operate ? operation_window_due(is_static) : 0;
+      if (length != 0) {
+        open(bin_of(theta_rad), length, d);
         static_checked_ = static_checked_ || is_static;
       }
       return d;
@@ -136,7 +142,7 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
     const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
     if (under_covered(bin) || (!is_static && !moving_ && since_start_ >= cfg_.max_wait_frames) ||
         (is_static && !cfg_.rotate_on_static_base && since_start_ >= cfg_.max_wait_frames)) {
-      open(bin, d);
+      open(bin, cfg_.length_frames, d);
       return d;
     }
     if (!moving_ && is_static && cfg_.rotate_on_static_base) {

@@ -9,8 +9,13 @@
 // variances over K). At the end, the parked-angle test's figures.
 //
 //   bench_sim_day [--hours H] [--thermal] [--forgetting-s S] [--duty D] [--window-s S]
+//                 [--csv FILE]
 //
-// --window-s: length of the windows after the campaign (default the plan's 5 s).
+// --csv: the hourly figures as CSV (default bench_sim_day.csv in the working
+// directory; plot with tools/plots/day_plot.py). At the end the model ADB and
+// its bound at 1, 3, 6, 12 and 24 h again, with the bound's fall against
+// 1/sqrt(T) and the ADB's.
+// --window-s: length of the operation windows (default the plan's, 30 s).
 // --thermal: the resonator's damping changes by 0.2 %/degC (thermal_damping)
 // under a +-2 degC sine with one period over the run. About 180 simulated s
 // per CPU s: a 24 h run takes ~8 CPU minutes (run it under nice).
@@ -19,6 +24,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "firmware/app/firmware.hpp"
 #include "sim_target/control.hpp"
@@ -35,6 +42,18 @@ struct Options {
   double forgetting_s = 0.0;  // 0: derived by the estimator
   double duty = fw::app::kDefaultOperationDuty;
   double window_s = 0.0;  // operation windows' length (0: the plan's)
+  std::string csv = "bench_sim_day.csv";
+};
+
+// One hourly observation.
+struct Hour {
+  double t_h = 0.0;
+  double off_pct = 0.0;
+  uint32_t windows = 0;
+  double memory_s = 0.0;
+  double temp_c = 0.0;
+  double adb_dph = 0.0;
+  double crb_dph = 0.0;
 };
 
 bool parse(int argc, char** argv, Options& o) {
@@ -50,10 +69,12 @@ bool parse(int argc, char** argv, Options& o) {
       o.window_s = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--duty") == 0 && has_value) {
       o.duty = std::atof(argv[++i]);
+    } else if (std::strcmp(argv[i], "--csv") == 0 && has_value) {
+      o.csv = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: bench_sim_day [--hours H] [--thermal] [--forgetting-s S] "
-                   "[--duty D]\n");
+                   "[--duty D] [--window-s S] [--csv FILE]\n");
       return false;
     }
   }
@@ -61,8 +82,8 @@ bool parse(int argc, char** argv, Options& o) {
 }
 
 // The model's angle-dependent bias error and its Cramer-Rao prediction (deg/h).
-void print_hour(const fw::app::Firmware& f, const sim::SimTarget& target,
-                const sim_run::RunConfig& job, double noise_sigma_v) {
+Hour observe(const fw::app::Firmware& f, const sim::SimTarget& target,
+             const sim_run::RunConfig& job, double noise_sigma_v) {
   const auto& est = f.estimator().estimator();
   const auto& sched = f.gyro().scheduler();
   const double k = job.firmware.gyro.angular_gain;
@@ -71,20 +92,63 @@ void print_hour(const fw::app::Firmware& f, const sim::SimTarget& target,
   const double scale =
       fx.enabled ? 1.0 + fx.rel_per_c * (target.true_state().temp_c - job.sim.resonator.temp_ref_c)
                  : 1.0;
-  double adb = 0.0, crb = 0.0;
+  Hour h;
+  h.t_h = f.gyro().status().chain.t_s / 3600.0;
+  h.off_pct = 100.0 * sched.excitation_off_fraction();
+  h.windows = sched.windows();
+  h.memory_s = est.forgetting_time_s();
+  h.temp_c = target.true_state().temp_c;
   if (est.has_model()) {
-    adb = std::hypot(est.model()(1) - scale * truth[1], est.model()(2) - scale * truth[2]) / k *
-          kRadSToDph;
+    h.adb_dph = std::hypot(est.model()(1) - scale * truth[1], est.model()(2) - scale * truth[2]) /
+                k * kRadSToDph;
     const est::ParamMatrix c = est.cramer_rao_bound(noise_sigma_v);
-    crb = std::sqrt(std::max(c(1, 1) + c(2, 2), 0.0)) / k * kRadSToDph;
+    h.crb_dph = std::sqrt(std::max(c(1, 1) + c(2, 2), 0.0)) / k * kRadSToDph;
   }
+  return h;
+}
+
+double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
+
+void print_hour(const Hour& h) {
   std::printf(
       "  %6.1f h  off %5.2f %%  windows %4u  memory %8.0f s  T %6.2f C  model ADB %8.4f"
       "  CRB %8.4f  ratio %5.2f\n",
-      f.gyro().status().chain.t_s / 3600.0, 100.0 * sched.excitation_off_fraction(),
-      sched.windows(), est.forgetting_time_s(), target.true_state().temp_c, adb, crb,
-      crb > 0 ? adb / crb : 0.0);
+      h.t_h, h.off_pct, h.windows, h.memory_s, h.temp_c, h.adb_dph, h.crb_dph,
+      ratio(h.adb_dph, h.crb_dph));
   std::fflush(stdout);
+}
+
+bool write_csv(const std::string& path, const std::vector<Hour>& hours) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) {
+    std::fprintf(stderr, "bench_sim_day: cannot write --csv %s\n", path.c_str());
+    return false;
+  }
+  std::fprintf(f, "t_h,excitation_off_pct,windows,memory_s,temp_c,model_adb_dph,crb_adb_dph\n");
+  for (const Hour& h : hours) {
+    std::fprintf(f, "%.4f,%.4f,%u,%.1f,%.4f,%.6g,%.6g\n", h.t_h, h.off_pct, h.windows, h.memory_s,
+                 h.temp_c, h.adb_dph, h.crb_dph);
+  }
+  return std::fclose(f) == 0;
+}
+
+// ADB and bound at 1, 3, 6, 12, 24 h (those the run reached); each against
+// the first, as the factor 1/sqrt(T) predicts (sqrt(1 h / T)).
+void print_convergence(const std::vector<Hour>& hours) {
+  if (hours.empty() || !(hours.front().crb_dph > 0.0)) return;
+  const Hour& first = hours.front();
+  std::printf("convergence (against %.0f h; 1/sqrt(T) is the steady resonator's rate):\n",
+              first.t_h);
+  for (double mark : {1.0, 3.0, 6.0, 12.0, 24.0}) {
+    for (const Hour& h : hours) {
+      if (std::fabs(h.t_h - mark) > 0.05) continue;
+      std::printf(
+          "  %4.0f h  model ADB %8.4f  bound %8.4f deg/h  ratio %5.2f  bound/first %5.3f  "
+          "ADB/first %5.3f  sqrt(first/T) %5.3f\n",
+          h.t_h, h.adb_dph, h.crb_dph, ratio(h.adb_dph, h.crb_dph), ratio(h.crb_dph, first.crb_dph),
+          ratio(h.adb_dph, first.adb_dph), std::sqrt(first.t_h / h.t_h));
+    }
+  }
 }
 }  // namespace
 
@@ -94,8 +158,10 @@ int main(int argc, char** argv) {
   sim_run::RunConfig job = sim_run::default_run(o.hours * 3600.0, 16);
   job.telemetry_hz = 10.0;  // the analysis needs no more; a day at 100 Hz is 2 GB of rows
   job.firmware.gyro.windows.operation_duty = o.duty;
-  job.firmware.gyro.windows.operation_length_frames =
-      static_cast<uint32_t>(std::lround(o.window_s * fw::kBaseRateHz));
+  if (o.window_s > 0.0) {
+    job.firmware.gyro.windows.operation_length_frames =
+        static_cast<uint32_t>(std::lround(o.window_s * fw::kBaseRateHz));
+  }
   job.firmware.estimator.ls.forgetting_time_s = o.forgetting_s;
   if (o.thermal) {
     job.sim.effects.thermal_damping.enabled = true;
@@ -112,11 +178,22 @@ int main(int argc, char** argv) {
               100.0 * o.duty, o.forgetting_s > 0 ? "set" : "derived");
   sim_run::RunOptions opt;
   opt.observe_every_s = 3600.0;
+  std::vector<Hour> hours;
+  hours.reserve(static_cast<std::size_t>(o.hours) + 1);
   opt.observer = [&](const fw::app::Firmware& f, const sim::SimTarget& t) {
-    print_hour(f, t, job, noise_sigma_v);
+    hours.push_back(observe(f, t, job, noise_sigma_v));
+    print_hour(hours.back());
   };
   sim_run::RunResult r = sim_run::run_simulation(job, opt);
   const bool passed = sim_run::judge(job, r);
+  print_convergence(hours);
+  for (const auto& p : r.parks) {
+    std::printf("  park %7.2f deg  raw %+9.3f  compensated %+8.4f  truth %+9.3f deg/h%s\n",
+                p.theta_rad * 180.0 / std::numbers::pi, p.bias_raw_dph, p.bias_comp_dph,
+                p.bias_model_dph, p.model_valid ? "" : "  (model not valid)");
+  }
+  std::printf("control-loop drift added: mean %+.4f deg/h\n", r.control_drift_mean_dph);
+  const bool written = write_csv(o.csv, hours);
   std::printf(
       "parked-angle test (%zu parks, %zu with the model valid): raw ADB %.3f, compensated "
       "ADB %.4f mean %+.4f deg/h; excitation off %.2f %%; %.0f simulated s per CPU s; "
@@ -124,5 +201,5 @@ int main(int argc, char** argv) {
       r.parks.size(), r.parks_model_valid, r.fit_raw.amplitude(), r.fit_comp.amplitude(),
       r.fit_comp.b0, 100.0 * r.excitation_off_fraction, r.realtime_factor_cpu,
       passed ? "pass" : "FAIL");
-  return passed ? 0 : 1;
+  return passed && written ? 0 : 1;
 }

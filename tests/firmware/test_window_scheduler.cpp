@@ -280,3 +280,46 @@ TEST(WindowScheduler, OperationWindowsHaveTheirOwnLength) {
   CHECK(opened_at >= 0);
   LONGS_EQUAL(30, closed_at - opened_at);
 }
+
+TEST(WindowScheduler, ChecksKeepTheirLengthWhileTheDutysWindowsAreLong) {
+  // GIVEN 10-frame campaign windows, 10-frame checks every 500 frames and
+  // 100-frame operation windows at 5 % excitation off
+  WindowConfig c = small_config();
+  c.check_period_frames = 500;
+  c.check_length_frames = 10;
+  c.operation_length_frames = 100;
+  c.operation_duty = 0.05;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  int f = 0;
+  for (; f < 200; ++f)
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  // WHEN the run goes on (the campaign's share falls below the duty)
+  uint32_t short_windows = 0, long_windows = 0;
+  int opened_at = -1;
+  for (int n = 0; n < 200000; ++n, ++f) {
+    const WindowDecision d = l.frame(0.05 * f, 2.0, good);
+    if (d.open) opened_at = n;
+    if (d.close) {
+      const int length = n - opened_at;
+      CHECK(length == 10 || length == 100);
+      (length == 10 ? short_windows : long_windows) += 1;
+    }
+  }
+  // THEN both kinds ran, and the share stays at the duty within one long
+  // window although the checks are forced whatever the duty
+  CHECK(short_windows > 0);
+  CHECK(long_windows > 0);
+  CHECK(l.s.excitation_off_fraction() <= c.operation_duty + 1e-12);
+  DOUBLES_EQUAL(c.operation_duty, l.s.excitation_off_fraction(),
+                100.0 / static_cast<double>(l.s.frames()));
+  // and the long windows take what the checks leave of the duty: the checks
+  // at most one per check period (10 / 500 = 2 %), so the long ones at least
+  // (5 % - 2 %) of the frames less what the campaign took, at most 5 %.
+  const double frames = static_cast<double>(l.s.frames());
+  const double campaign_off = 200.0;  // at most 8 bins x 2 x 10 frames, plus the duty
+  CHECK(static_cast<double>(long_windows) >=
+        ((c.operation_duty - 10.0 / 500.0) * frames - campaign_off) / 100.0 - 1.0);
+  CHECK(static_cast<double>(long_windows) <= c.operation_duty * frames / 100.0);
+}

@@ -37,6 +37,11 @@ struct WindowConfig {
   // time), as long as the amplitude lost in one stays within what the AGC
   // recovers.
   uint32_t operation_length_frames = 0;
+  // Length of the check windows (0: the operation windows' length). Checks
+  // are forced every check period whatever the duty, so long operation
+  // windows want short checks (a 30 s check every 10 min alone is 5 %
+  // excitation off); a long operation window is a check as well.
+  uint32_t check_length_frames = 0;
 };
 
 struct WindowDecision {
@@ -82,10 +87,14 @@ class WindowScheduler {
 
  private:
   bool under_covered(uint32_t bin) const;
-  bool operation_window_due(bool is_static) const;
-  void open(uint32_t bin, WindowDecision& d);
+  // Length (frames) of the window due now after the campaign, 0: none.
+  uint32_t operation_window_due(bool is_static) const;
+  void open(uint32_t bin, uint32_t length_frames, WindowDecision& d);
   uint32_t operation_length() const {
     return cfg_.operation_length_frames != 0 ? cfg_.operation_length_frames : cfg_.length_frames;
+  }
+  uint32_t check_length() const {
+    return cfg_.check_length_frames != 0 ? cfg_.check_length_frames : operation_length();
   }
   uint32_t least_covered_bin() const;
 

@@ -46,9 +46,20 @@ std::string bias_test_coverage(const RunResult& r) {
           r.parks_model_valid, r.parks.size());
   s += r.t_model_valid_s >= 0.0 ? fmt("; valid from %.1f s)", r.t_model_valid_s)
                                 : std::string("; the model was never valid)");
-  if (r.bias_test_needs_s > 0.0)
-    s += fmt("; this resonator needs a run of at least %.0f s (--duration %.0f)",
-             r.bias_test_needs_s, r.bias_test_needs_s);
+  if (r.bias_test_needs_s <= 0.0) return s;
+  s += fmt("; this resonator needs a run of at least %.0f s (--duration %.0f)", r.bias_test_needs_s,
+           r.bias_test_needs_s);
+  if (r.t_model_valid_s >= 0.0 && r.t_bias_goal_s >= 0.0) {
+    // The estimate: the same bias test started once the model is valid and
+    // its uncertainty has converged to the goal (at least: a longer run
+    // parks longer, and a campaign that waits for the parks to cover its
+    // 4 theta bins ends later).
+    s +=
+        fmt(": the bias test started when the model is valid (%.0f s) and its bias "
+            "uncertainty is a third of the %.3g deg/h goal (%s%.0f s%s)",
+            r.t_model_valid_s, r.bias_goal_dph, r.t_bias_goal_extrapolated ? "about " : "",
+            r.t_bias_goal_s, r.t_bias_goal_extrapolated ? ", from its convergence so far" : "");
+  }
   return s;
 }
 
@@ -170,6 +181,9 @@ void drift_json(JsonWriter& w, const RunResult& r) {
   w.integer("parks_model_valid", static_cast<long long>(r.parks_model_valid));
   w.number("t_model_valid_s", r.t_model_valid_s);
   w.number("bias_test_needs_s", r.bias_test_needs_s);
+  w.number("bias_goal_dph", r.bias_goal_dph);
+  w.number("t_bias_goal_s", r.t_bias_goal_s);
+  w.boolean("t_bias_goal_extrapolated", r.t_bias_goal_extrapolated);
   w.number("control_drift_mean_dph", r.control_drift_mean_dph);
   w.begin_array("parks");
   for (const auto& p : r.parks) {

@@ -3,6 +3,7 @@
 // the parked-angle bias and its 4 theta fit, the Allan deviation; and the
 // truth itself (the simulated resonator's parameters and drift).
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -57,6 +58,13 @@ void accumulate_errors(RunResult& r, const RunConfig& job) {
 
 // Parked bias: slope of the angle error over each park, in deg/h, and the
 // b + A sin 4theta + B cos 4theta fits.
+void bias_goal_time(RunResult& r, const RunConfig& job) {
+  r.bias_goal_dph = job.bias_goal_dph;
+  const GoalTime g = uncertainty_goal_time(r.convergence, job.bias_goal_dph / 3.0);
+  r.t_bias_goal_s = g.t_s;
+  r.t_bias_goal_extrapolated = g.extrapolated;
+}
+
 // The compensated fit is over the parks where the firmware stood behind its
 // model (compensation valid on every row): before that the output is the raw
 // angle plus an unproven model, and a slow-converging resonator would be
@@ -103,11 +111,15 @@ void parked_bias(RunResult& r, const RunConfig& job) {
   r.fit_raw = fit_bias_4theta(th, braw);
   r.fit_comp = fit_bias_4theta(th_valid, bcomp);
   r.fit_model = fit_bias_4theta(th, bmodel);
-  if (!job.parks.empty() && r.parks_model_valid < r.parks.size()) {
-    // The same bias test started once the model is valid: the run shifted by
-    // the wait (or, never valid here, at least twice as long).
-    const double wait_s =
-        r.t_model_valid_s >= 0.0 ? r.t_model_valid_s - job.parks.front().t_begin_s : job.duration_s;
+  bias_goal_time(r, job);
+  if (!job.parks.empty() &&
+      (r.parks_model_valid < r.parks.size() || r.t_bias_goal_s > job.parks.front().t_begin_s)) {
+    // The same bias test started once the model is valid and its bias
+    // uncertainty has reached the goal: the run shifted by the wait (or,
+    // never valid here, at least twice as long).
+    const double wait_s = r.t_model_valid_s >= 0.0 ? std::max(r.t_model_valid_s, r.t_bias_goal_s) -
+                                                         job.parks.front().t_begin_s
+                                                   : job.duration_s;
     if (wait_s > 0.0) r.bias_test_needs_s = std::ceil(job.duration_s + wait_s);
   }
 }
@@ -157,6 +169,31 @@ void analyse_run(RunResult& r, const RunConfig& job) {
   accumulate_errors(r, job);
   parked_bias(r, job);
   still_allan(r, job);
+}
+
+GoalTime uncertainty_goal_time(std::span<const ConvergencePoint> c, double target_dph) {
+  GoalTime g;
+  for (const ConvergencePoint& p : c) {
+    if (p.bias_sigma_dph <= target_dph) {
+      g.t_s = p.t_s;
+      return g;
+    }
+  }
+  const std::size_t n = c.size();
+  if (n < 4 || !(target_dph > 0.0)) return g;
+  // The information 1/sigma^2 grows in proportion to the windows taken: its
+  // rate over the last half of the solves (the schedule now in force, not
+  // the campaign's), carried on from the last solve.
+  std::vector<double> t, info;
+  for (std::size_t i = n / 2; i < n; ++i) {
+    t.push_back(c[i].t_s);
+    info.push_back(1.0 / (c[i].bias_sigma_dph * c[i].bias_sigma_dph));
+  }
+  const double rate_per_s = slope(t, info);
+  if (!(rate_per_s > 0.0)) return g;
+  g.t_s = t.back() + (1.0 / (target_dph * target_dph) - info.back()) / rate_per_s;
+  g.extrapolated = true;
+  return g;
 }
 
 }  // namespace hrg::sim_run

@@ -279,6 +279,19 @@ void summarise_executive(RunResult& r, const fw::Gyro& g) {
   r.frames = ex.frame_stats();
 }
 
+// The model's bias uncertainty after each accepted solve (RunResult::convergence).
+void record_convergence(const fw::app::Firmware& firmware, const RunConfig& job,
+                        uint32_t& solves_seen, RunResult& r) {
+  const fw::EstimatorPort& ident = firmware.estimator();
+  if (ident.solves_accepted() == solves_seen) return;
+  solves_seen = ident.solves_accepted();
+  const est::ParamMatrix& c = ident.estimator().last_solution().covariance;
+  const double var = c(est::kDnuC, est::kDnuC) + c(est::kDnuS, est::kDnuS);
+  if (!(var > 0.0)) return;
+  r.convergence.push_back({firmware.gyro().status().chain.t_s,
+                           std::sqrt(var) / job.firmware.gyro.angular_gain * kRadSToDph});
+}
+
 // What the firmware identified, against the truth and the Cramer-Rao bound.
 void summarise_identification(RunResult& r, const RunConfig& job,
                               const fw::app::Firmware& firmware) {
@@ -344,6 +357,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   const std::clock_t cpu0 = std::clock();
   std::size_t next_fault = 0;
   fw::Mode last_mode = fw::Mode::power_up;
+  uint32_t solves_seen = 0;
   RowStamper stamp(job);
   AngleReference ref;
   LabTable lab;
@@ -355,6 +369,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   for (uint64_t k = 0; k < frames; ++k) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
+    record_convergence(*firmware, job, solves_seen, r);
     const fw::GyroStatus& st = gyro.status();
     stamp.after_block(*firmware, target, RowStamper::stamped(k, row_every));
     track_events(gyro, target, last_mode, r);

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,10 @@ struct RunConfig {
   std::vector<ParkedInterval> parks;  // the bias test (empty: none)
   std::vector<FaultEvent> faults;     // in time order
   std::string description;
+  // The drift requirement the compensated angle-dependent bias is to meet
+  // (the seed paper's 3 deg/h): the run length a resonator needs is taken
+  // from when its model's bias uncertainty reaches a third of it.
+  double bias_goal_dph = 3.0;
 };
 
 // The default scenario: the seed's resonator (5 kHz, Q 5e6, dQ/Q 0.1, split
@@ -97,6 +102,24 @@ struct TelemetryRow {
   // not count as an error), deg.
   double raw_error_deg, out_error_deg;
 };
+
+// The model's uncertainty after an accepted solve: the damping anisotropy's
+// standard errors as input rate (hypot of the cos and sin terms), deg/h.
+struct ConvergencePoint {
+  double t_s = 0.0;
+  double bias_sigma_dph = 0.0;
+};
+
+// When the model's bias uncertainty reaches target_dph: the first point at
+// or below it (measured), else the time its information 1/sigma^2 reaches
+// 1/target^2 at the rate it grew over the last half of the points
+// (extrapolated); t_s -1 when there is no estimate (fewer than 4 points, no
+// growth).
+struct GoalTime {
+  double t_s = -1.0;
+  bool extrapolated = false;
+};
+GoalTime uncertainty_goal_time(std::span<const ConvergencePoint> c, double target_dph);
 
 struct ParkResult {
   double theta_rad = 0.0;       // mean pattern angle while parked
@@ -170,6 +193,13 @@ struct RunResult {
   std::size_t parks_model_valid = 0;
   double t_model_valid_s = -1.0;
   double bias_test_needs_s = 0.0;
+  // The model's bias uncertainty after each accepted solve, and when it
+  // reaches a third of RunConfig::bias_goal_dph: measured (the run got there)
+  // or extrapolated from the information's recent growth (-1: no estimate).
+  std::vector<ConvergencePoint> convergence;
+  double bias_goal_dph = 0.0;  // RunConfig::bias_goal_dph
+  double t_bias_goal_s = -1.0;
+  bool t_bias_goal_extrapolated = false;
   std::vector<AllanPoint> allan;  // of the compensated output rate, rad/s
   double allan_span_s = 0.0;      // length of the still stretch it was computed on
   double tracking_rms_deg = 0.0;  // compensated output - true, after operate

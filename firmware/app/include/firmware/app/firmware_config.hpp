@@ -49,9 +49,19 @@ FirmwareConfig default_firmware_config(const ConverterLayout& conv,
 // Sets the window plan's fields of `w` (the others are left alone).
 void apply_window_plan(WindowConfig& w, WindowPlan plan);
 
-// Fills the derived fields: the chain's converter fields from `conv`, and K
-// and the set point from `cfg.gyro` into the chain, the estimator and the
-// monitor, and the telemetry's envelope reference from the chain.
+// Share of the amplitude decay time (Q / (pi f)) an operation window may
+// last (WindowConfig::operation_length_frames).
+inline constexpr double kOperationWindowDecayShare = 0.1;
+
+// Shortens the operation windows to kOperationWindowDecayShare of the
+// resonator's decay time (from the chain's Q and centre frequency), never
+// below the campaign's windows; a length of 0 (the campaign's) is kept.
+void limit_operation_windows(WindowConfig& w, const dsp::ChainConfig& chain);
+
+// Fills the derived fields: the chain's converter fields from `conv`, the
+// operation windows' limit from the chain's Q, and K and the set point from
+// `cfg.gyro` into the chain, the estimator and the monitor, and the
+// telemetry's envelope reference from the chain.
 void derive(FirmwareConfig& cfg, const ConverterLayout& conv);
 
 // The telemetry's fixed reference (the chain's centre frequency), the
