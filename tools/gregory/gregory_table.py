@@ -126,7 +126,9 @@ def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration
     rep = json.load(open(os.path.join(out, "report.json")))
     d = rep["drift"]
     comp = rep.get("compensation", {})
-    return {"raw": d["raw"]["adb_dph"], "comp": d["compensated"]["adb_dph"],
+    # Not fitted: no park had the compensation valid (not measured, not 0).
+    comp_adb = d["compensated"]["adb_dph"] if d["compensated"].get("fitted", True) else math.nan
+    return {"raw": d["raw"]["adb_dph"], "comp": comp_adb,
             "passed": rep["passed"], "valid": comp.get("valid", True),
             "in_force": comp.get("calibration", {}),
             "rounds": comp.get("self_calibration", {}).get("rounds_applied", 0),
