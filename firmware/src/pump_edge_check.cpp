@@ -110,7 +110,9 @@ void PumpEdgeCheck::begin_edge() {
     pre.add(t, in_frame(ring_[i], ring_phase_[i], t));
     // X += r P appears as cx += Re(rP), sx -= Im(rP): P turns as X does.
     const std::array<double, 4> p =
-        in_frame({ring_pump_[i][0], -ring_pump_[i][1], 0.0, 0.0}, ring_phase_[i], t);
+        in_frame({ring_pump_[i][0] * std::cos(ring_pump_[i][1]),
+                  -ring_pump_[i][0] * std::sin(ring_pump_[i][1]), 0.0, 0.0},
+                 ring_phase_[i], t);
     const double w = 1.0 / nd + d * (t - t_mean) / sxx;
     pump_re_v_ += w * p[0];
     pump_im_v_ -= w * p[1];
@@ -187,10 +189,9 @@ void PumpEdgeCheck::add_row(const ChainRecord& r, bool pump_on, bool steady) {
     ring_phase_[ring_pos_] = centre;
     ring_pos_ = (ring_pos_ + 1) % kMaxFitRows;
     if (on_rows_ < kMaxFitRows) ++on_rows_;
-    // The pump this row saw: its amplitude over the demodulator's window,
-    // at the phase the chain gives it against the NCO.
-    ring_pump_[(ring_pos_ + kMaxFitRows - 1) % kMaxFitRows] = {
-        r.pump_seen_v * std::cos(r.pump_phase_rad), r.pump_seen_v * std::sin(r.pump_phase_rad)};
+    // The pump this row saw: its amplitude over the demodulator's window, at
+    // the phase the chain gives it against the NCO (turned into parts at the edge).
+    ring_pump_[(ring_pos_ + kMaxFitRows - 1) % kMaxFitRows] = {r.pump_seen_v, r.pump_phase_rad};
     was_on_ = true;
     last_amplitude_v_ = r.wave.a_A_v;
     return;

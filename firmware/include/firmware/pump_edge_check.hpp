@@ -76,7 +76,7 @@ struct PumpEdgeStatus {
 
 class PumpEdgeCheck {
  public:
-  static constexpr uint32_t kMaxFitRows = 128;
+  static constexpr uint32_t kMaxFitRows = 64;
 
   explicit PumpEdgeCheck(const PumpEdgeCheckConfig& cfg);
   // The correction of the pickoffs changed: what was seen before is forgotten.
@@ -113,10 +113,11 @@ class PumpEdgeCheck {
 
   PumpEdgeCheckConfig cfg_;
   PumpEdgeStatus status_{};
-  std::array<std::array<double, 4>, kMaxFitRows> ring_{};       // the last pump-on rows
-  std::array<uint32_t, kMaxFitRows> ring_phase_{};              // their centre NCO phases
-  std::array<std::array<double, 2>, kMaxFitRows> ring_pump_{};  // the pump they saw (V)
-  std::array<uint32_t, 4> end_phase_{};                         // the last rows' block-end phases
+  std::array<std::array<double, 4>, kMaxFitRows> ring_{};  // the last pump-on rows
+  std::array<uint32_t, kMaxFitRows> ring_phase_{};         // their centre NCO phases
+  // The pump they saw: amplitude (V), phase against the NCO (rad).
+  std::array<std::array<double, 2>, kMaxFitRows> ring_pump_{};
+  std::array<uint32_t, 4> end_phase_{};  // the last rows' block-end phases
   uint32_t end_pos_ = 0;
   // The edge's frame: the NCO phase at the last pump-on row's centre and its
   // advance per row then.
