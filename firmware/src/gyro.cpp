@@ -17,6 +17,7 @@ Gyro::Gyro(hal::Board& board, SignalChain& chain, ResonatorIdentifier& identifie
       monitor_(cfg.monitor),
       scheduler_(cfg.windows),
       output_(cfg.angular_gain, 1.0 / kBaseRateHz),
+      pump_edge_(cfg.pump_edge),
       envelope_(cfg.envelope),
       link_(board.can, kCanRestartRuns, cfg.calibration_service) {
   monitor_.set_amplitude_set_v(cfg_.amplitude_set_v);
@@ -82,6 +83,8 @@ void Gyro::task_chain(Gyro& g) {
   g.dac_error_ = hal::is_fatal(dst);
   g.status_.excitation_on = c.pump_on || c.forcers_on;
   if (!c.pump_on) g.status_.chain.pump_v = 0.0;
+  g.pump_edge_.add_row(g.status_.chain, c.pump_on, g.mode_.mode() == Mode::operate);
+  g.status_.pump_edge = g.pump_edge_.status();
   if (g.enable_written_ != p.enable_line || g.exec_.tick() == 0) {
     (void)g.board_.excitation_enable.write(p.enable_line && g.board_ok_);
     g.enable_written_ = p.enable_line;
@@ -266,7 +269,8 @@ void Gyro::check_model() {
   // a fit made while turning is most likely wrong) agreed with it.
   status_.compensation_applied = status_.model_checks_failed == failed_before_restart_;
   const bool checked = cfg_.identify && cfg_.windows.check_period_frames != 0;
-  status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0);
+  status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0) &&
+                               status_.pump_edge.verdict != PumpEdgeVerdict::step;
 }
 
 void Gyro::restart_identification() {

@@ -287,12 +287,18 @@ PickoffOutput Resonator::measured_with_effects() const {
   }
   if (effects_.drive_feedthrough.enabled) {
     // c V e^{i psi}: Re(Vc e^{i psi} e^{iwt}) = cos psi V(t) - sin psi V(t - T/4).
+    // V is the pump voltage at this sampling instant t_k, as the catalogue
+    // and the averaged model define it (a band-limited ADC sees the held
+    // steps' fundamental, not the step's edge). The last held word (over
+    // [t_k - h, t_k)) carries the phase of its middle, half a step before
+    // t_k: psi is advanced by w h / 2 (9 deg at 5 kHz and 100 kHz).
     const auto& ft = effects_.drive_feedthrough;
     const double quarter = std::min(kHistory - 2.0, 1.0 / (4.0 * f_ref_hz_ * std::abs(dt_last_)));
+    const double half_step_rad = dt_last_ > 0.0 ? kPi * f_ref_hz_ * dt_last_ : 0.0;
     const double v_now = pump_hist_[hist_pos_];
     const double v_lag = pump_delayed(quarter);
-    const double px = ft.x_phase_deg * kDegToRad;
-    const double py = ft.y_phase_deg * kDegToRad;
+    const double px = ft.x_phase_deg * kDegToRad + half_step_rad;
+    const double py = ft.y_phase_deg * kDegToRad + half_step_rad;
     x += ft.x_v_per_v * (std::cos(px) * v_now - std::sin(px) * v_lag);
     y += ft.y_v_per_v * (std::cos(py) * v_now - std::sin(py) * v_lag);
   }

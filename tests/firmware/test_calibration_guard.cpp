@@ -74,3 +74,45 @@ TEST(CalibrationGuard, AboveTheNoiseButBetterThanBeforeConfirms) {
   worse.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
   CHECK_TRUE(worse.judge(checked(9, 31.0), true, 220.0));
 }
+
+// A calibration with a feedthrough part acts only while the pump runs,
+// where no free-decay window looks: the switch-off step check judges it too.
+TEST(CalibrationGuard, AFeedthroughCalibrationIsConfirmedOnlyOnceTheSwitchOffsShowNoStep) {
+  using hrg::fw::PumpEdgeVerdict;
+  CalibrationGuard g(kMaxMisfit);
+  g.applied(CalibrationSource::file, 7, false, true, 0.0, {}, false);
+  CHECK_TRUE(g.status().feedthrough);
+  // The check window after the campaign agrees, the edges are not decided yet.
+  CHECK_FALSE(g.judge(checked(4, 90.0), true, 100.0, PumpEdgeVerdict::unknown));
+  CHECK_FALSE(g.judge(checked(5, 1.0), true, 120.0, PumpEdgeVerdict::unknown));
+  CHECK(g.status().verdict == CalibrationVerdict::on_trial);
+  CHECK_TRUE(g.status().window_agreed);
+  // Then the edges are consistent: confirmed.
+  CHECK_FALSE(g.judge(checked(5, 1.0), true, 121.0, PumpEdgeVerdict::consistent));
+  CHECK(g.status().verdict == CalibrationVerdict::confirmed);
+  // A step later still withdraws it.
+  CHECK_TRUE(g.judge(checked(5, 1.0), true, 300.0, PumpEdgeVerdict::step));
+  CHECK(g.status().verdict == CalibrationVerdict::withdrawn);
+  CHECK(g.status().edge == PumpEdgeVerdict::step);
+  DOUBLES_EQUAL(300.0, g.status().judged_s, 0.0);
+  CHECK_EQUAL(1u, g.status().withdrawals);
+}
+
+TEST(CalibrationGuard, AStepWithdrawsAFeedthroughCalibrationAtOnceButNotAPickoffOne) {
+  using hrg::fw::PumpEdgeVerdict;
+  // GIVEN a feedthrough calibration, the campaign still running
+  CalibrationGuard ft(kMaxMisfit);
+  ft.applied(CalibrationSource::file, 7, false, true, 0.0, {}, false);
+  // THEN a step at the first switch-off withdraws it (no model needed)
+  CHECK_TRUE(ft.judge(checked(0, 0.0), false, 3.0, PumpEdgeVerdict::step));
+  CHECK(ft.status().verdict == CalibrationVerdict::withdrawn);
+  // GIVEN a calibration of the pickoff map only: a step is not its doing
+  CalibrationGuard pickoff(kMaxMisfit);
+  pickoff.applied(CalibrationSource::file, 7, false, false, 0.0, {}, false);
+  CHECK_FALSE(pickoff.judge(checked(0, 0.0), false, 3.0, PumpEdgeVerdict::step));
+  CHECK(pickoff.status().verdict == CalibrationVerdict::on_trial);
+  // ... and it is confirmed by its check window alone.
+  CHECK_FALSE(pickoff.judge(checked(1, 1.0), true, 100.0, PumpEdgeVerdict::step));
+  CHECK_FALSE(pickoff.judge(checked(2, 1.0), true, 120.0, PumpEdgeVerdict::step));
+  CHECK(pickoff.status().verdict == CalibrationVerdict::confirmed);
+}

@@ -292,7 +292,7 @@ TEST(SeedDriftExample, DriftTermsMatchEquationSixWithTheHalfSplit) {
   DOUBLES_EQUAL(46.0, worst_deg_h, 0.5);
 }
 
-TEST(Effects, FullRateFeedthroughIsTheHeldPumpVoltageShiftedByPsi) {
+TEST(Effects, FullRateFeedthroughIsThePumpVoltageAtTheSampleShiftedByPsi) {
   // GIVEN a resonator at rest and x feedthrough c = 0.02 at psi = 40 deg
   Effects fx;
   fx.drive_feedthrough.enabled = true;
@@ -310,10 +310,12 @@ TEST(Effects, FullRateFeedthroughIsTheHeldPumpVoltageShiftedByPsi) {
     r.step(d, kDt);
     if (n >= 80) acc += r.measured().x_v * std::polar(2.0 / 20.0, -w * r.time_s());
   }
-  // THEN x carries c V0 e^{i(phi + psi)}, seen half a sample late (the held value)
-  const cplx expected = 0.02 * v0 * std::polar(1.0, phi + 40.0 * kDegToRad - 0.5 * w * kDt);
-  DOUBLES_EQUAL(std::abs(expected), std::abs(acc), 0.02 * std::abs(expected));
-  DOUBLES_EQUAL(0.0, std::remainder(std::arg(acc) - std::arg(expected), 2 * kPi), 0.02);
+  // THEN x carries c V0 e^{i(phi + psi)} of the pump at the sampling instant
+  // (as the averaged model and the catalogue: not the held word, which is
+  // half a sample, 9 deg, late)
+  const cplx expected = 0.02 * v0 * std::polar(1.0, phi + 40.0 * kDegToRad);
+  DOUBLES_EQUAL(std::abs(expected), std::abs(acc), 0.005 * std::abs(expected));
+  DOUBLES_EQUAL(0.0, std::remainder(std::arg(acc) - std::arg(expected), 2 * kPi), 0.005);
 }
 
 TEST(ParametricPump, FullRateAndAveragedAgreeWithGapNonUniformity) {

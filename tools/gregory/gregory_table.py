@@ -112,6 +112,11 @@ def readout_error_deg(telemetry):
     return worst
 
 
+def adb(v):
+    """An ADB for the table; '-' when not measured (no park had the compensation valid)."""
+    return "-" if math.isnan(v) else "%.3g" % v
+
+
 def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration=None):
     cmd = [hrg, "sim", "--scenario", scenario, "--out", out, "--no-plots", "--quiet"]
     if duration is not None:
@@ -126,7 +131,9 @@ def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration
     rep = json.load(open(os.path.join(out, "report.json")))
     d = rep["drift"]
     comp = rep.get("compensation", {})
-    return {"raw": d["raw"]["adb_dph"], "comp": d["compensated"]["adb_dph"],
+    # Not fitted: no park had the compensation valid (not measured, not 0).
+    comp_adb = d["compensated"]["adb_dph"] if d["compensated"].get("fitted", True) else math.nan
+    return {"raw": d["raw"]["adb_dph"], "comp": comp_adb,
             "passed": rep["passed"], "valid": comp.get("valid", True),
             "in_force": comp.get("calibration", {}),
             "rounds": comp.get("self_calibration", {}).get("rounds_applied", 0),
@@ -212,14 +219,15 @@ def main():
         for run in (b, c, o, r):
             if run["valid"] and run["comp"] > run["raw"]:
                 goals.append("valid compensation worse than raw")
-        print("| %s | %.3g | %.3g | %s | %.3g | %s, %d | %.3g | %.3g | %s | %.3g | %.3g | %.3g | %s | %s |" % (
-            n, b["raw"], b["comp"], "yes" if b["valid"] else "NO",
-            o["comp"], "yes" if o["valid"] else "NO", o["rounds"], r["comp"], c["comp"],
+        print("| %s | %.3g | %s | %s | %s | %s, %d | %s | %s | %s | %.3g | %.3g | %.3g | %s | %s |" % (
+            n, b["raw"], adb(b["comp"]), "yes" if b["valid"] else "NO",
+            adb(o["comp"]), "yes" if o["valid"] else "NO", o["rounds"], adb(r["comp"]), adb(c["comp"]),
             "yes" if c["valid"] else "NO", clean,
             b["readout"], c["readout"], verdict, "; ".join(goals) if goals else "met"))
         if goals:
             missed.append(n)
-    print("ADB in deg/h of input rate; readout error in deg (max |theta_A - true|).")
+    print("ADB in deg/h of input rate ('-': not measured, the compensation was valid in no park); "
+          "readout error in deg (max |theta_A - true|).")
     if a.check and missed:
         print("goals missed: " + ", ".join(missed))
         return 1

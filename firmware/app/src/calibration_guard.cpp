@@ -23,8 +23,9 @@ const char* to_string(CalibrationVerdict v) {
   return "?";
 }
 
-void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool identity, double t_s,
-                               const EstimatorHealth& h, bool checking) {
+void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool identity,
+                               bool feedthrough, double t_s, const EstimatorHealth& h,
+                               bool checking) {
   const uint32_t withdrawals = status_.withdrawals;
   status_ = CalibrationStatus{};
   status_.withdrawals = withdrawals;
@@ -32,6 +33,7 @@ void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool id
   status_.verdict = identity ? CalibrationVerdict::none : CalibrationVerdict::on_trial;
   status_.crc32 = crc32;
   status_.applied_s = t_s;
+  status_.feedthrough = !identity && feedthrough;
   // A check made before (with the previous correction) is the reference
   // the new one must not be worse than.
   status_.misfit_before = checking && h.windows_checked > 0 ? h.window_misfit : 0.0;
@@ -39,29 +41,43 @@ void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool id
   was_checking_ = checking;
 }
 
-bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s) {
-  if (status_.verdict != CalibrationVerdict::on_trial) return false;
-  // Windows checked while the campaign runs (against an early model) or
-  // the one that ends it are no verdict: count from the campaign's end.
-  if (!checking || !was_checking_) {
-    checks_seen_ = h.windows_checked;
-    was_checking_ = checking;
-    return false;
-  }
-  if (h.windows_checked == checks_seen_) return false;
-  checks_seen_ = h.windows_checked;
-  const double m = h.window_misfit;
-  status_.misfit_after = m;
-  status_.judged_s = t_s;
-  const bool noise_like = m <= max_misfit_;
-  const bool not_worse = status_.misfit_before > 0.0 && m <= status_.misfit_before;
-  if (noise_like || not_worse) {
-    status_.verdict = CalibrationVerdict::confirmed;
-    return false;
-  }
+bool CalibrationGuard::withdraw(double t_s) {
   status_.verdict = CalibrationVerdict::withdrawn;
+  status_.judged_s = t_s;
   ++status_.withdrawals;
   return true;
+}
+
+bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s,
+                             PumpEdgeVerdict edge) {
+  const bool in_force = status_.verdict == CalibrationVerdict::on_trial ||
+                        status_.verdict == CalibrationVerdict::confirmed;
+  if (!in_force) return false;
+  status_.edge = edge;
+  // A step at the switch-offs is evidence at any time (no model involved).
+  if (status_.feedthrough && edge == PumpEdgeVerdict::step) return withdraw(t_s);
+  if (status_.verdict != CalibrationVerdict::on_trial) return false;
+  const bool edge_ok = !status_.feedthrough || edge == PumpEdgeVerdict::consistent;
+  // Windows checked while the campaign runs (against an early model) or
+  // the one that ends it are no verdict: count from the campaign's end.
+  if (!status_.window_agreed) {
+    if (!checking || !was_checking_) {
+      checks_seen_ = h.windows_checked;
+      was_checking_ = checking;
+      return false;
+    }
+    if (h.windows_checked == checks_seen_) return false;
+    checks_seen_ = h.windows_checked;
+    const double m = h.window_misfit;
+    status_.misfit_after = m;
+    status_.judged_s = t_s;
+    const bool noise_like = m <= max_misfit_;
+    const bool not_worse = status_.misfit_before > 0.0 && m <= status_.misfit_before;
+    if (!(noise_like || not_worse)) return withdraw(t_s);
+    status_.window_agreed = true;
+  }
+  if (edge_ok) status_.verdict = CalibrationVerdict::confirmed;
+  return false;
 }
 
 }  // namespace hrg::fw::app

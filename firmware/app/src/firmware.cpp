@@ -21,6 +21,11 @@ bool is_identity_resonator(const Calibration& cal) {
          cal.nonlinear_damping_per_v2 == 0.0;
 }
 
+bool has_feedthrough(const Calibration& cal) {
+  return cal.feedthrough_x_re_v_per_v != 0.0 || cal.feedthrough_x_im_v_per_v != 0.0 ||
+         cal.feedthrough_y_re_v_per_v != 0.0 || cal.feedthrough_y_im_v_per_v != 0.0;
+}
+
 bool significant(const est::PickoffSelfCalResult& r, double n_sigma) {
   return std::fabs(r.gain) > n_sigma * r.gain_sigma ||
          std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad;
@@ -41,7 +46,9 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
   }
   cfg_.calibration = cal;
   estimator_.set_resonator_model(cal);
+  gyro_.restart_pump_edge_check();
   guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
+                 has_feedthrough(cal),
                  gyro_.status().chain.t_s, estimator_.health(), checking());
   return true;
 }
@@ -75,11 +82,13 @@ void Firmware::self_calibrate() {
 }
 
 void Firmware::judge_calibration() {
-  if (!guard_.judge(estimator_.health(), checking(), gyro_.status().chain.t_s)) return;
+  const GyroStatus& st = gyro_.status();
+  if (!guard_.judge(estimator_.health(), checking(), st.chain.t_s, st.pump_edge.verdict)) return;
   // The chain goes back to the raw pickoffs; the verdict stays reported.
   chain_.clear_electronics_correction();
   cfg_.calibration = kIdentityCalibration;
   estimator_.set_resonator_model(kIdentityCalibration);
+  gyro_.restart_pump_edge_check();
 }
 
 }  // namespace hrg::fw::app

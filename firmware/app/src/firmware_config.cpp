@@ -87,6 +87,10 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
   cfg.chain.amplitude_setpoint_v = cfg.gyro.amplitude_set_v;
   cfg.gyro.monitor.amplitude_set_v = cfg.gyro.amplitude_set_v;
   cfg.gyro.envelope = envelope_reference_config(cfg.chain, conv);
+  cfg.gyro.pump_edge.drive_free_rows = drive_free_blocks(cfg.chain, conv.dac_latency_samples);
+  cfg.gyro.pump_edge.edge_offset_rows = pump_edge_offset_rows(cfg.chain);
+  const double l = static_cast<double>(cfg.chain.block_frames);
+  cfg.gyro.pump_edge.row_centre_blocks = (1.0 + 0.5 * dsp::kDecimatorOrder * (l - 1.0)) / l;
 }
 
 can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& chain,
@@ -108,6 +112,11 @@ uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_sam
   return static_cast<uint32_t>(1.0 + std::ceil((chain.dac_lead_frames + dac_latency_samples +
                                                 (dsp::kDecimatorOrder - 1.0) * (l - 1.0)) /
                                                l));
+}
+
+double pump_edge_offset_rows(const dsp::ChainConfig& chain) {
+  const double l = static_cast<double>(chain.block_frames);
+  return (chain.dac_lead_frames + 0.5 + 0.5 * dsp::kDecimatorOrder * (l - 1.0)) / l;
 }
 
 }  // namespace hrg::fw::app

@@ -13,6 +13,7 @@
 #include "firmware/fault_monitor.hpp"
 #include "firmware/mode.hpp"
 #include "firmware/mode_machine.hpp"
+#include "firmware/pump_edge_check.hpp"
 #include "firmware/chain_and_identifier.hpp"
 #include "firmware/window_scheduler.hpp"
 #include "hal/board.hpp"
@@ -40,6 +41,10 @@ struct GyroConfig {
   // EstimatorHealth::window_misfit, above this): the output is then the raw
   // angle, reported so.
   double max_window_misfit = 4.0;
+  // Do no harm while the pump runs: the step of the corrected signal at
+  // every switch-off (PumpEdgeCheck). A step above its tolerance makes the
+  // compensation not valid.
+  PumpEdgeCheckConfig pump_edge{};
   WindowConfig windows{};
   MonitorConfig monitor{};
   // How the telemetry's envelopes are referred and stamped (set from the
@@ -68,9 +73,11 @@ struct GyroStatus {
   // The drift compensation is in force: the campaign has ended and no check
   // window has disagreed with its model (false for good after one did).
   bool compensation_applied = false;
-  // ... and a check window has agreed with it: the compensated output is
-  // one the firmware stands behind.
+  // ... and a check window has agreed with it, and the switch-offs show no
+  // step of the corrected signal (pump_edge): the compensated output is one
+  // the firmware stands behind.
   bool compensation_valid = false;
+  PumpEdgeStatus pump_edge{};
   uint32_t model_checks_failed = 0;
   uint32_t adc_errors = 0;
   uint32_t adc_missed_blocks = 0;
@@ -116,6 +123,12 @@ class Gyro {
   // signals the identifier saw changed: a new pickoff correction). The
   // identifier is restarted by its owner. Call outside a window.
   void restart_identification();
+  // The correction of the pickoffs changed: the switch-off steps seen
+  // through the old one are forgotten.
+  void restart_pump_edge_check() {
+    pump_edge_.reset();
+    status_.pump_edge = pump_edge_.status();
+  }
   // Re-zeroes the output angle at the current pattern angle.
   void zero_output() { output_.rereference(); }
 
@@ -179,6 +192,7 @@ class Gyro {
   WindowScheduler scheduler_;
   AngleOutput output_;
   GyroStatus status_{};
+  PumpEdgeCheck pump_edge_;
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
   can::EnvelopeReference envelope_;

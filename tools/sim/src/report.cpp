@@ -95,11 +95,26 @@ bool judge(const RunConfig& job, RunResult& r) {
     const fw::app::CalibrationStatus& c = r.calibration;
     const std::string before =
         c.misfit_before > 0.0 ? fmt(" and the check before it (%.2f)", c.misfit_before) : "";
+    if (c.edge == fw::PumpEdgeVerdict::step) {
+      r.failures.push_back(
+          fmt("the %s calibration was withdrawn at %.1f s: the signal it "
+              "corrected steps at the pump's switch-offs (its feedthrough "
+              "removal is wrong); the pickoffs are read raw",
+              fw::app::to_string(c.source), c.judged_s));
+    } else {
+      r.failures.push_back(
+          fmt("the %s calibration was withdrawn at %.1f s: its check window's "
+              "misfit %.2f is above the noise (%.1f)%s; the pickoffs are read raw",
+              fw::app::to_string(c.source), c.judged_s, c.misfit_after,
+              job.firmware.gyro.max_window_misfit, before.c_str()));
+    }
+  }
+  if (r.pump_edge.verdict == fw::PumpEdgeVerdict::step) {
     r.failures.push_back(
-        fmt("the %s calibration was withdrawn at %.1f s: its check window's "
-            "misfit %.2f is above the noise (%.1f)%s; the pickoffs are read raw",
-            fw::app::to_string(c.source), c.judged_s, c.misfit_after,
-            job.firmware.gyro.max_window_misfit, before.c_str()));
+        fmt("the drift compensation is not valid: the corrected signal steps by %.3g V "
+            "(+- %.2g) at the pump's switch-offs, above the %.3g V it may (an uncorrected "
+            "or wrongly corrected drive feedthrough)",
+            r.pump_edge.step_v, r.pump_edge.step_sigma_v, r.pump_edge.tolerance_v));
   }
   if (!job.parks.empty() && !r.fit_comp.ok) {
     // Too few parks with the model valid to fit: the compensation is not
@@ -120,6 +135,23 @@ namespace {
 
 // The calibration's trial: where it came from, the check window that judged
 // it (misfits over the fit's own residual), withdrawn or not.
+// The switch-off step check: the residual feedthrough it measures (V/V per
+// volt of pump, against the NCO) and the step at the last edge's pump.
+void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
+  w.begin_object("pump_edge");
+  w.string("verdict", fw::to_string(e.verdict));
+  w.integer("edges", e.edges);
+  w.number("residual_x_re_v_per_v", e.x_re);
+  w.number("residual_x_im_v_per_v", e.x_im);
+  w.number("residual_y_re_v_per_v", e.y_re);
+  w.number("residual_y_im_v_per_v", e.y_im);
+  w.number("residual_sigma_v_per_v", e.sigma_v_per_v);
+  w.number("step_v", e.step_v);
+  w.number("step_sigma_v", e.step_sigma_v);
+  w.number("tolerance_v", e.tolerance_v);
+  w.end_object();
+}
+
 void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
                       const fw::Calibration& in_force) {
   w.begin_object("calibration");
@@ -129,6 +161,9 @@ void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
   w.number("pickoff_y_misalignment_deg", in_force.pickoff_y_misalignment_rad / kDegRad);
   w.string("source", fw::app::to_string(c.source));
   w.string("verdict", fw::app::to_string(c.verdict));
+  w.boolean("feedthrough", c.feedthrough);
+  w.boolean("window_agreed", c.window_agreed);
+  w.string("edge", fw::to_string(c.edge));
   w.integer("crc32", c.crc32);
   w.number("applied_s", c.applied_s);
   w.number("misfit_before", c.misfit_before);
@@ -304,6 +339,7 @@ std::string report_json(const RunConfig& job, const RunResult& r) {
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
   calibration_json(w, r.calibration, r.final_calibration);
+  pump_edge_json(w, r.pump_edge);
   self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
   w.end_object();
   identification_json(w, r);

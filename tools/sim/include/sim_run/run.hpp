@@ -182,7 +182,9 @@ struct RunResult {
   // The firmware's pickoff self-calibration at the end (its last solve).
   est::PickoffSelfCalResult self_calibration{};
   fw::app::SelfCalibrationStatus self_calibration_applied{};
-  fw::Calibration final_calibration{};  // the calibration in force at the end
+  fw::Calibration final_calibration{};
+  fw::PumpEdgeStatus
+      pump_edge{};  // the switch-off step check at the end  // the calibration in force at the end
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;

@@ -6,12 +6,17 @@
 // check has judged it. The first check window after it (the campaign's own
 // windows prove nothing) must be consistent with the noise (misfit at most
 // the gyro's max_window_misfit) or, when a check was made before it was
-// applied, not worse than that one. Otherwise it is withdrawn (the chain
-// goes back to no correction) and the firmware says so.
+// applied, not worse than that one. A calibration with a feedthrough part is
+// also judged by the switch-off steps of the corrected signal
+// (PumpEdgeCheck, which free-decay windows cannot see): confirmed only once
+// they are consistent, withdrawn (on trial or confirmed) as soon as they
+// show a step. Otherwise it is withdrawn (the chain goes back to no
+// correction) and the firmware says so.
 
 #include <cstdint>
 
 #include "firmware/estimator_health.hpp"
+#include "firmware/pump_edge_check.hpp"
 
 namespace hrg::fw::app {
 
@@ -39,7 +44,11 @@ struct CalibrationStatus {
   double misfit_before = 0.0;  // last check misfit before it (0: no check before)
   double misfit_after = 0.0;   // the check that judged it
   double judged_s = 0.0;       // time of that check
-  uint32_t withdrawals = 0;    // calibrations withdrawn since start
+  bool feedthrough = false;    // it has a feedthrough part (the switch-off steps judge it too)
+  bool window_agreed = false;  // a check window agreed with it
+  // The switch-off step check at the verdict (a withdrawal by a step: `step`).
+  PumpEdgeVerdict edge = PumpEdgeVerdict::unknown;
+  uint32_t withdrawals = 0;  // calibrations withdrawn since start
 };
 
 class CalibrationGuard {
@@ -49,16 +58,28 @@ class CalibrationGuard {
   // A calibration is now in force (`identity`: nothing to judge). `h` is the
   // estimator's health at that instant, `checking`: its check windows count
   // (the campaign is over).
+  // `feedthrough`: it changes the feedthrough removal.
+  void applied(CalibrationSource source, uint32_t crc32, bool identity, bool feedthrough,
+               double t_s, const EstimatorHealth& h, bool checking);
+  // Once per frame, with the switch-off step check's verdict (reset when the
+  // calibration was applied). True when the calibration in force must be
+  // withdrawn now.
+  bool judge(const EstimatorHealth& h, bool checking, double t_s, PumpEdgeVerdict edge);
+  // Without a feedthrough part and a step check.
   void applied(CalibrationSource source, uint32_t crc32, bool identity, double t_s,
-               const EstimatorHealth& h, bool checking);
-  // Once per frame. True when the calibration in force must be withdrawn now.
-  bool judge(const EstimatorHealth& h, bool checking, double t_s);
+               const EstimatorHealth& h, bool checking) {
+    applied(source, crc32, identity, false, t_s, h, checking);
+  }
+  bool judge(const EstimatorHealth& h, bool checking, double t_s) {
+    return judge(h, checking, t_s, PumpEdgeVerdict::unknown);
+  }
 
   const CalibrationStatus& status() const { return status_; }
 
  private:
   double max_misfit_;
   CalibrationStatus status_{};
+  bool withdraw(double t_s);
   uint32_t checks_seen_ = 0;
   bool was_checking_ = false;
 };

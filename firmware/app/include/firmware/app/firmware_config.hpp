@@ -74,4 +74,11 @@ can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& c
 // its block) lies before the N (L - 1) + 1 samples the demodulator averages.
 uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_samples);
 
+// The instant the pump stops, in rows after the last block the chain ran
+// with it on: that block's last DAC word (held dac_lead_frames - 1/2 .. + 1/2
+// after its frame) ends dac_lead_frames + L - 1/2 frames after the block's
+// start; a row is centred N (L - 1)/2 frames before its last sample. 3.505 at
+// the default 100-frame blocks (PumpEdgeCheckConfig::edge_offset_rows).
+double pump_edge_offset_rows(const dsp::ChainConfig& chain);
+
 }  // namespace hrg::fw::app

@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: MIT
+// PumpEdgeCheck: the corrected quadratures of a wave whose state is
+// continuous at the switch-off, plus a residual feedthrough r P while the
+// pump runs. The check reads r back from the step of the two sides' lines at
+// the switch instant, with the noise the line-extrapolation formula gives,
+// and says `step` when r V0 is above the readout tolerance 2 a sin(theta_tol).
+#include "firmware/pump_edge_check.hpp"
+
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <random>
+
+#include "support/cpputest.hpp"
+
+using hrg::fw::ChainRecord;
+using hrg::fw::PumpEdgeCheck;
+using hrg::fw::PumpEdgeCheckConfig;
+using hrg::fw::PumpEdgeVerdict;
+using cplx = std::complex<double>;
+
+namespace {
+
+constexpr double kNoiseV = 3e-5;  // per quadrature and row (the default chain's, ~CRB)
+constexpr double kPumpV = 3.0;
+constexpr double kPumpPhaseRad = 0.7;
+constexpr double kAmplitudeV = 1.0;
+
+// Gaussian noise from the standardised mt19937_64 (Box-Muller by hand: the
+// same bits on every standard library).
+class Noise {
+ public:
+  double operator()() {
+    const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
+    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+    return kNoiseV * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.141592653589793 * u2);
+  }
+
+ private:
+  std::mt19937_64 rng_{2026};
+};
+
+// One switch-off edge: `on_rows` rows with the pump on, then `off_rows`
+// without. The true envelopes are lines in the row index with a kink at the
+// switch instant t_e (the pump stops adding energy, the quadrature loop
+// stops holding a_B): continuous there. Pump-on rows carry r P; the rows
+// inside the demodulator's averaging span after the switch carry nonsense.
+struct EdgeFeed {
+  PumpEdgeCheckConfig cfg{};
+  cplx r_x{0.0, 0.0};
+  cplx r_y{0.0, 0.0};
+  Noise noise{};
+  // The NCO: advance per row, and how far it turns away from that after the
+  // switch-off (the PLL answering a phase step), approached as 1 - e^{-t/20}.
+  uint32_t nco_advance = 0x9e3779b9u;
+  double nco_turn_rad = 0.0;
+  uint32_t nco_base = 0;
+  // The pump's amplitude swinging row to row by this fraction (the AGC's chatter).
+  double pump_swing = 0.0;
+
+  void run(PumpEdgeCheck& c, uint32_t on_rows, uint32_t off_rows) {
+    const double t_e = cfg.edge_offset_rows;
+    const cplx x_e{kAmplitudeV * 0.8, -0.05};
+    const cplx y_e{kAmplitudeV * 0.6, 0.02};
+    for (uint32_t k = 0; k < on_rows + off_rows; ++k) {
+      const bool on = k < on_rows;
+      // Row index relative to the last pump-on row (0).
+      const double t = static_cast<double>(k) - static_cast<double>(on_rows - 1);
+      const cplx slope_x = on ? cplx{0.0, 1e-6} : cplx{-2.5e-6, 3e-6};
+      const cplx slope_y = on ? cplx{1e-6, 0.0} : cplx{-2e-6, -4e-6};
+      cplx x = x_e + slope_x * (t - t_e);
+      cplx y = y_e + slope_y * (t - t_e);
+      const double v0 = kPumpV * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      const cplx p = std::polar(v0, kPumpPhaseRad);
+      if (on) {
+        x += r_x * p;
+        y += r_y * p;
+      } else if (t < cfg.drive_free_rows) {
+        x += cplx{0.01, 0.01};  // the switching transient in the averaging span
+      }
+      // The NCO's phase at the row's centre runs ahead of the steady
+      // advance by turn(t); its block end is row_centre_blocks later.
+      const auto turn = [&](double tc) {
+        return tc > 0.0 ? nco_turn_rad * (1.0 - std::exp(-tc / 20.0)) : 0.0;
+      };
+      const double t_end = t + cfg.row_centre_blocks;
+      const double end_rad = turn(t_end);
+      x *= std::polar(1.0, -turn(t));
+      y *= std::polar(1.0, -turn(t));
+      ChainRecord row{};
+      row.nco_phase = nco_base + static_cast<uint32_t>(k) * nco_advance +
+                      static_cast<uint32_t>(static_cast<int32_t>(
+                          std::lround(end_rad / 6.283185307179586 * 4294967296.0)));
+      row.quad_v = {x.real() + noise(), -x.imag() + noise(), y.real() + noise(),
+                    -y.imag() + noise()};
+      row.pump_v = on ? v0 : 0.0;
+      row.pump_seen_v = on ? v0 : 0.0;
+      row.pump_phase_rad = kPumpPhaseRad;
+      row.wave.a_A_v = kAmplitudeV;
+      c.add_row(row, on);
+    }
+  }
+};
+
+// Noise of one part of r from one edge: both lines' extrapolation to t_e,
+// var = sigma^2 (1/N + (t_e - mean t)^2 / Sxx), Sxx = N (N^2 - 1) / 12.
+double sigma_r_one_edge(const PumpEdgeCheckConfig& cfg) {
+  const double n = cfg.fit_rows;
+  const double sxx = n * (n * n - 1.0) / 12.0;
+  const double pre_mean = -(n - 1.0) / 2.0;
+  const double post_mean = cfg.drive_free_rows + (n - 1.0) / 2.0;
+  const double d_pre = cfg.edge_offset_rows - pre_mean;
+  const double d_post = cfg.edge_offset_rows - post_mean;
+  const double f = 2.0 / n + (d_pre * d_pre + d_post * d_post) / sxx;
+  return kNoiseV * std::sqrt(f) / kPumpV;
+}
+
+double tolerance_v(const PumpEdgeCheckConfig& cfg) {
+  return 2.0 * kAmplitudeV * std::sin(cfg.max_readout_step_rad);
+}
+
+}  // namespace
+
+TEST_GROUP(PumpEdgeCheck){};
+
+TEST(PumpEdgeCheck, AContinuousStateShowsNoStepWithTheNoiseTheLinesPredict) {
+  // GIVEN a wave with no residual feedthrough, one switch-off
+  EdgeFeed feed;
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN one edge, r within 4 sigma of 0, the sigma of the line formula
+  // (estimated from the fits' residuals: within 10 %)
+  LONGS_EQUAL(1, c.status().edges);
+  const double sigma = sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(sigma, c.status().sigma_v_per_v, 0.1 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().x_re, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().x_im, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().y_re, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().y_im, 4.0 * sigma);
+  // AND the step is far below the tolerance of 0.005 deg of readout
+  // (2 * 1 V * sin(8.73e-5) = 1.745e-4 V): consistent
+  DOUBLES_EQUAL(1.745e-4, c.status().tolerance_v, 1e-7);
+  CHECK(c.status().verdict == PumpEdgeVerdict::consistent);
+}
+
+TEST(PumpEdgeCheck, AResidualFeedthroughIsReadBackAndAStepAboveTheToleranceFails) {
+  // GIVEN residual feedthrough r_x = 2e-4 at 0.3 rad, r_y = -1e-4 V/V:
+  // a step of 6e-4 V at 3 V of pump, 3.4x the tolerance
+  EdgeFeed feed;
+  feed.r_x = std::polar(2e-4, 0.3);
+  feed.r_y = {-1e-4, 0.0};
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN r is read back within 4 sigma per part
+  const double sigma = sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(feed.r_x.real(), c.status().x_re, 4.0 * sigma);
+  DOUBLES_EQUAL(feed.r_x.imag(), c.status().x_im, 4.0 * sigma);
+  DOUBLES_EQUAL(feed.r_y.real(), c.status().y_re, 4.0 * sigma);
+  DOUBLES_EQUAL(feed.r_y.imag(), c.status().y_im, 4.0 * sigma);
+  DOUBLES_EQUAL(2e-4 * kPumpV, c.status().step_v, 4.0 * sigma * kPumpV);
+  CHECK(c.status().verdict == PumpEdgeVerdict::step);
+}
+
+TEST(PumpEdgeCheck, AStepAtTheToleranceIsUndecidedAndHalfOfItConsistent) {
+  EdgeFeed feed;
+  const PumpEdgeCheckConfig& cfg = feed.cfg;
+  // GIVEN a step equal to the tolerance (within the 3 sigma band either side)
+  feed.r_x = {tolerance_v(cfg) / kPumpV, 0.0};
+  PumpEdgeCheck c(cfg);
+  feed.run(c, 200, 100);
+  CHECK(c.status().verdict == PumpEdgeVerdict::unknown);
+  // GIVEN half the tolerance (7.7 sigma below it)
+  PumpEdgeCheck half(cfg);
+  feed.r_x = {0.5 * tolerance_v(cfg) / kPumpV, 0.0};
+  feed.run(half, 200, 100);
+  CHECK(half.status().verdict == PumpEdgeVerdict::consistent);
+}
+
+TEST(PumpEdgeCheck, EdgesAverageAndAResetForgetsThem) {
+  EdgeFeed feed;
+  PumpEdgeCheck c(feed.cfg);
+  // GIVEN four edges: the sigma of the mean is half that of one
+  for (int i = 0; i < 4; ++i)
+    feed.run(c, 200, 100);
+  LONGS_EQUAL(4, c.status().edges);
+  const double sigma = sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(0.5 * sigma, c.status().sigma_v_per_v, 0.05 * sigma);
+  // WHEN the correction changes (reset) and the next edge has a large residual
+  c.reset();
+  CHECK(c.status().verdict == PumpEdgeVerdict::unknown);
+  LONGS_EQUAL(0, c.status().edges);
+  feed.r_x = {1e-3, 0.0};
+  feed.run(c, 200, 100);
+  // THEN only that edge counts
+  LONGS_EQUAL(1, c.status().edges);
+  DOUBLES_EQUAL(1e-3, c.status().x_re, 4.0 * sigma);
+  CHECK(c.status().verdict == PumpEdgeVerdict::step);
+}
+
+TEST(PumpEdgeCheck, TooFewRowsOnEitherSideAreNoEdge) {
+  EdgeFeed feed;
+  feed.r_x = {1e-3, 0.0};
+  PumpEdgeCheck c(feed.cfg);
+  // GIVEN fewer pump-on rows than the fit needs, then an off stretch shorter
+  // than the transient plus the fit
+  feed.run(c, 40, 100);
+  feed.run(c, 200, 60);
+  // THEN nothing is measured
+  LONGS_EQUAL(0, c.status().edges);
+  CHECK(c.status().verdict == PumpEdgeVerdict::unknown);
+}
+
+TEST(PumpEdgeCheck, PumpOnRowsOutsideOperationStartThePumpOnSideAgain) {
+  EdgeFeed feed;
+  feed.r_x = {1e-3, 0.0};
+  PumpEdgeCheck c(feed.cfg);
+  ChainRecord ring_up{};
+  ring_up.pump_v = 10.0;
+  // GIVEN 200 steady rows, then a row of ring-up (the loops do not hold the
+  // wave), then fewer steady rows than the fit needs before the switch-off
+  feed.run(c, 200, 0);
+  c.add_row(ring_up, true, false);
+  feed.run(c, 40, 100);
+  // THEN no edge is measured
+  LONGS_EQUAL(0, c.status().edges);
+}
+
+TEST(PumpEdgeCheck, TheNcoTurningAfterTheSwitchOffIsNoStep) {
+  // GIVEN no residual feedthrough, but the NCO (whose frame the quadratures
+  // are in) turns 3e-3 rad away after the switch-off, as the PLL does when
+  // the measured phase steps: in the NCO's frame X moves by 3e-3 V
+  EdgeFeed feed;
+  feed.nco_turn_rad = 3e-3;
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN in the edge's fixed frame there is no step (4 sigma)
+  LONGS_EQUAL(1, c.status().edges);
+  const double sigma = sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(0.0, c.status().x_re, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().x_im, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().y_re, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().y_im, 4.0 * sigma);
+  CHECK(c.status().verdict == PumpEdgeVerdict::consistent);
+}
+
+TEST(PumpEdgeCheck, APumpThatSwingsRowToRowIsWeightedAsTheLineWeightsItsRows) {
+  // GIVEN r_x = 2e-4 V/V while the pump swings between 0.3 and 5.7 V from
+  // row to row (the AGC's chatter early in operation)
+  EdgeFeed feed;
+  feed.pump_swing = 0.9;
+  feed.r_x = std::polar(2e-4, -0.4);
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN r is read back (4 sigma of the one-edge noise, at the weighted
+  // pump's amplitude, which is within 2x of the mean)
+  const double sigma = 2.0 * sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(feed.r_x.real(), c.status().x_re, 4.0 * sigma);
+  DOUBLES_EQUAL(feed.r_x.imag(), c.status().x_im, 4.0 * sigma);
+  DOUBLES_EQUAL(0.0, c.status().y_re, 4.0 * sigma);
+  CHECK(c.status().verdict == PumpEdgeVerdict::step);
+}
