@@ -2,6 +2,8 @@
 #include "estimator/pickoff_self_calibration.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -9,70 +11,165 @@
 
 namespace hrg::est {
 
+namespace {
+
+constexpr int kE = kSelfCalParams;
+constexpr int kQ = kSelfCalQuadParams;
+// Columns of the level-of-E row.
+constexpr int kRho = 3;
+constexpr int kBh = 4;
+constexpr int kHc = 5;
+constexpr int kHs = 6;
+// Column of the quadrature row.
+constexpr int kPhi = 2;
+
+// Window sums to the window's contribution with its offset removed.
+template <int N>
+Eigen::Matrix<double, N, N> centred(const Eigen::Matrix<double, N, 1>& m,
+                                    const Eigen::Matrix<double, N, N>& mm, double n) {
+  return mm - m * m.transpose() / n;
+}
+
+// Least squares on an augmented state [N b; b' yy] restricted to columns
+// [first, first + K): solution, residual sum of squares, inverse of N.
+template <int K, int A>
+struct Fit {
+  Eigen::Matrix<double, K, 1> p;
+  Eigen::Matrix<double, K, K> n_inv;
+  double rss;
+};
+
+template <int K, int A>
+Fit<K, A> fit(const Eigen::Matrix<double, A, A>& aug, int first) {
+  const Eigen::Matrix<double, K, K> n = aug.template block<K, K>(first, first);
+  const Eigen::Matrix<double, K, 1> b = aug.template block<K, 1>(first, A - 1);
+  const Eigen::LDLT<Eigen::Matrix<double, K, K>> ldlt(n);
+  Fit<K, A> f;
+  f.p = ldlt.solve(b);
+  f.n_inv = ldlt.solve(Eigen::Matrix<double, K, K>::Identity());
+  f.rss = std::max(0.0, aug(A - 1, A - 1) - f.p.dot(b));
+  return f;
+}
+
+// Subtracts sum_j d_j z_j from the observation of an augmented state
+// (y' = y - d.z), exact on the accumulated sums: A' = T A T'.
+template <int A>
+void subtract_from_observation(Eigen::Matrix<double, A, A>& aug,
+                               const Eigen::Matrix<double, A, 1>& d) {
+  Eigen::Matrix<double, A, A> t = Eigen::Matrix<double, A, A>::Identity();
+  t.row(A - 1) -= d.transpose();
+  aug = t * aug * t.transpose();
+}
+
+// rho (the 4theta coefficient of ln E) of a gain mismatch and back.
+double rho_of_gain(double g) {
+  const double k = (1.0 + g) * (1.0 + g);
+  return (k - 1.0) / (k + 1.0);
+}
+
+}  // namespace
+
 void PickoffSelfCalibration::reset() { *this = PickoffSelfCalibration{}; }
 
 Status PickoffSelfCalibration::begin_window() {
   if (open_) return Status::in_window;
   open_ = true;
   n_ = 0;
-  sz_.setZero();
-  szz_.setZero();
-  szy_.setZero();
-  sy_ = 0.0;
-  syy_ = 0.0;
-  int_c4_ = 0.0;
-  int_s4_ = 0.0;
+  samples_in_window_ = 0;
+  in_block_ = 0;
+  block_e_.setZero();
+  block_q_.setZero();
+  se_.setZero();
+  see_.setZero();
+  sq_.setZero();
+  sqq_.setZero();
+  int_r_ = int_s_ = int_c4_ = int_s4_ = 0.0;
   turn_4th_ = 0.0;
   return Status::ok;
 }
 
 Status PickoffSelfCalibration::add_sample(const WaveSample& s) {
   if (!open_) return Status::not_in_window;
-  if (!(std::isfinite(s.t_s) && std::isfinite(s.E_v2) && std::isfinite(s.theta_A_rad)) ||
+  if (!(std::isfinite(s.t_s) && std::isfinite(s.E_v2) && std::isfinite(s.theta_A_rad) &&
+        std::isfinite(s.a_A_v) && std::isfinite(s.a_B_v)) ||
       !(s.E_v2 > 0.0)) {
     return Status::bad_sample;
   }
-  if (n_ > 0 && !(s.t_s > last_t_)) return Status::time_not_increasing;
+  if (samples_in_window_ > 0 && !(s.t_s > last_t_)) return Status::time_not_increasing;
   const double c4 = std::cos(4.0 * s.theta_A_rad);
   const double s4 = std::sin(4.0 * s.theta_A_rad);
-  if (n_ == 0) {
+  // r = R/E, s = S/E (dsp/wave_variables.hpp), the quadrature reading Q/E.
+  const double p_over_e = (s.a_A_v * s.a_A_v - s.a_B_v * s.a_B_v) / s.E_v2;
+  const double r = p_over_e * c4;
+  const double sn = p_over_e * s4;
+  const double qn = 2.0 * s.a_A_v * s.a_B_v / s.E_v2;
+  const double ln_e = std::log(s.E_v2);
+  if (samples_in_window_ == 0) {
     t0_ = s.t_s;
+    y0_ = ln_e;
   } else {
-    // Trapezoidal integrals of the anisotropy's 4theta pattern.
-    const double h = s.t_s - last_t_;
-    int_c4_ += 0.5 * h * (c4 + last_c4_);
-    int_s4_ += 0.5 * h * (s4 + last_s4_);
+    // Trapezoidal integrals of the anisotropy's and the split's patterns.
+    const double h = 0.5 * (s.t_s - last_t_);
+    int_r_ += h * (r + last_r_);
+    int_s_ += h * (sn + last_s_);
+    int_c4_ += h * (c4 + last_c4_);
+    int_s4_ += h * (s4 + last_s4_);
     turn_4th_ += std::remainder(4.0 * s.theta_A_rad - last_4th_, 2.0 * std::numbers::pi);
   }
   last_4th_ = 4.0 * s.theta_A_rad;
   last_t_ = s.t_s;
+  last_r_ = r;
+  last_s_ = sn;
   last_c4_ = c4;
   last_s4_ = s4;
-  // ln E = -2 nu t - 2 dnu_C I_C - 2 dnu_S I_S - g cos4th + 2 b sin4th + c_w.
-  Vec z;
-  z << -2.0 * (s.t_s - t0_), -2.0 * int_c4_, -2.0 * int_s4_, -c4, 2.0 * s4;
-  const double y = std::log(s.E_v2);
-  sz_ += z;
-  szz_.noalias() += z * z.transpose();
-  szy_ += z * y;
-  sy_ += y;
-  syy_ += y * y;
-  ++n_;
+  VecE v;
+  v << -2.0 * (s.t_s - t0_), -2.0 * int_r_, -2.0 * int_s_, -r, 2.0 * sn, 0.5 * (r * r - sn * sn),
+      r * sn, ln_e - y0_;
+  VecQ q;
+  q << 2.0 * int_s4_, -2.0 * int_c4_, s4, qn;
+  block_e_ += v;
+  block_q_ += q;
+  ++samples_in_window_;
+  if (++in_block_ == kSelfCalBlockSamples) fold_block();
   return Status::ok;
+}
+
+void PickoffSelfCalibration::fold_block() {
+  // The block's means are one row each: the model is linear in the columns.
+  const double inv = 1.0 / static_cast<double>(kSelfCalBlockSamples);
+  const VecE v = block_e_ * inv;
+  const VecQ q = block_q_ * inv;
+  se_ += v;
+  see_.noalias() += v * v.transpose();
+  sq_ += q;
+  sqq_.noalias() += q * q.transpose();
+  ++n_;
+  block_e_.setZero();
+  block_q_.setZero();
+  in_block_ = 0;
 }
 
 Status PickoffSelfCalibration::end_window(int min_samples) {
   if (!open_) return Status::not_in_window;
   open_ = false;
-  if (n_ < min_samples) return Status::too_short;
-  // Centring within the window removes its offset c_w.
+  // A partial last block is left out.
+  if (samples_in_window_ < min_samples || n_ < 3) return Status::too_short;
   const double n = static_cast<double>(n_);
-  hh_.noalias() += szz_ - sz_ * sz_.transpose() / n;
-  hy_.noalias() += szy_ - sz_ * (sy_ / n);
-  yy_ += syy_ - sy_ * sy_ / n;
+  // Centring removes the window's offset.
+  ae_ += centred<kE + 1>(se_, see_, n);
+  aq_ += centred<kQ + 1>(sq_, sqq_, n);
+  // Detrending (offset and slope of its own: the per-window decay test)
+  // projects every column on [1, t] of this window: A - C' G^-1 C.
+  Eigen::Matrix2d g;
+  g << n, se_(0), se_(0), see_(0, 0);
+  Eigen::Matrix<double, 2, kE + 1> c;
+  c.row(0) = se_.transpose();
+  c.row(1) = see_.row(0);
+  ad_ += see_ - c.transpose() * g.inverse() * c;
   ++windows_;
   if (std::fabs(turn_4th_) >= kSelfCalMinTurnRad) ++turning_;
-  samples_ += n_;
+  samples_ += samples_in_window_;
+  blocks_ += n_;
   return Status::ok;
 }
 
@@ -81,28 +178,69 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
   r.windows = windows_;
   r.samples = samples_;
   r.turning_windows = turning_;
-  const int dof = samples_ - windows_ - kSelfCalParams;
-  if (windows_ == 0 || dof <= 0) return r;
-  r.kappa_2 = conditioning_of<kSelfCalParams>(hh_).kappa_2;
-  if (turning_ == 0 || !(r.kappa_2 <= max_kappa)) {
+  const int dof = blocks_ - windows_ - kE;
+  const int dof_quad = blocks_ - windows_ - kQ;
+  // The per-window decay fit: W more parameters, nu's column gone.
+  const int dof_detrended = blocks_ - 2 * windows_ - (kE - 1);
+  if (windows_ < 2 || dof_detrended <= 0) return r;
+  const Eigen::Matrix<double, kE, kE> n_e = ae_.topLeftCorner<kE, kE>();
+  const Eigen::Matrix<double, kQ, kQ> n_q = aq_.topLeftCorner<kQ, kQ>();
+  r.kappa_2 = conditioning_of<kE>(n_e).kappa_2;
+  r.kappa_2_quad = conditioning_of<kQ>(n_q).kappa_2;
+  if (turning_ == 0 || !(r.kappa_2 <= max_kappa) || !(r.kappa_2_quad <= max_kappa)) {
     r.status = Status::ill_conditioned;
     return r;
   }
-  const Eigen::LDLT<Mat> ldlt(hh_);
-  const Vec p = ldlt.solve(hy_);
-  const double rss = std::max(0.0, yy_ - p.dot(hy_));
-  const double var = rss / dof;
-  const Mat cov = ldlt.solve(Mat::Identity()) * var;
+  const Fit<kE, kE + 1> e = fit<kE, kE + 1>(ae_, 0);
+  const Fit<kQ, kQ + 1> q = fit<kQ, kQ + 1>(aq_, 0);
+  const Fit<kE - 1, kE + 1> d = fit<kE - 1, kE + 1>(ad_, 1);
+  const double var = e.rss / dof;
+  const double var_q = q.rss / dof_quad;
+  const double rho = e.p(kRho);
+  const double bh = e.p(kBh);
+  const double sin2b = 2.0 * bh * std::sqrt(std::max(0.0, 1.0 - rho * rho));
+  if (!(std::fabs(rho) < 0.5) || !(std::fabs(sin2b) < 0.5)) {
+    r.status = Status::ill_conditioned;  // not a pickoff map the model holds for
+    return r;
+  }
   r.status = Status::ok;
-  r.nu_per_s = p(0);
-  r.dnu_c_per_s = p(1);
-  r.dnu_s_per_s = p(2);
-  r.gain = p(3);
-  r.misalignment_rad = p(4);
-  r.gain_sigma = std::sqrt(cov(3, 3));
-  r.misalignment_sigma_rad = std::sqrt(cov(4, 4));
+  r.nu_per_s = e.p(0);
+  r.dnu_c_per_s = e.p(1);
+  r.dnu_s_per_s = e.p(2);
+  // rho = (k - 1)/(k + 1) with k = (1 + g)^2: 1 + g = sqrt((1 + rho)/(1 - rho)).
+  r.gain = std::sqrt((1.0 + rho) / (1.0 - rho)) - 1.0;
+  r.gain_sigma = std::sqrt(e.n_inv(kRho, kRho) * var) / ((1.0 - rho) * std::sqrt(1.0 - rho * rho));
+  r.misalignment_rad = 0.5 * std::asin(sin2b);
+  r.misalignment_sigma_rad = std::sqrt(e.n_inv(kBh, kBh) * var) * std::sqrt(1.0 - rho * rho) /
+                             std::cos(2.0 * r.misalignment_rad);
+  r.level_8th_c = e.p(kHc);
+  r.level_8th_s = e.p(kHs);
+  r.dw_c_rad_s = q.p(0);
+  r.dw_s_rad_s = q.p(1);
+  r.phase_rad = q.p(kPhi);
+  r.phase_sigma_rad = std::sqrt(q.n_inv(kPhi, kPhi) * var_q);
   r.residual_rms = std::sqrt(var);
+  // The per-window decay test.
+  const double extra = static_cast<double>(windows_ - 1);
+  r.decay_f = ((e.rss - d.rss) / extra) / (d.rss / dof_detrended);
+  r.decay_f_limit = 1.0 + kSelfCalDecaySigmas * std::sqrt(2.0 / extra);
+  r.decay_consistent = r.decay_f <= r.decay_f_limit;
   return r;
+}
+
+void PickoffSelfCalibration::refer_to_applied(const PickoffSelfCalResult& applied) {
+  if (applied.status != Status::ok) return;
+  const double rho = rho_of_gain(applied.gain);
+  VecE de = VecE::Zero();
+  de(kRho) = rho;
+  de(kBh) = std::sin(2.0 * applied.misalignment_rad) / (2.0 * std::sqrt(1.0 - rho * rho));
+  de(kHc) = applied.level_8th_c;
+  de(kHs) = applied.level_8th_s;
+  subtract_from_observation<kE + 1>(ae_, de);
+  subtract_from_observation<kE + 1>(ad_, de);
+  VecQ dq = VecQ::Zero();
+  dq(kPhi) = applied.phase_rad;
+  subtract_from_observation<kQ + 1>(aq_, dq);
 }
 
 }  // namespace hrg::est

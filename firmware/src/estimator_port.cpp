@@ -41,13 +41,13 @@ void EstimatorPort::end_self_cal_window() {
   if (self_cal_.end_window() == est::Status::ok) self_cal_dirty_ = true;
 }
 
-void EstimatorPort::restart() {
+void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& applied) {
   est_ = est::Estimator(cfg_);
-  self_cal_.reset();
+  self_cal_.refer_to_applied(applied);
   self_cal_result_ = {};
+  self_cal_dirty_ = true;  // the re-referred residual, solved at the next solve()
   health_ = {};
   dirty_ = false;
-  self_cal_dirty_ = false;
   last_control_t_s_ = -1.0;
 }
 

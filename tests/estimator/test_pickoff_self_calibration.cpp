@@ -25,9 +25,10 @@ constexpr double kMixedRates[] = {0.0, 100.0, -60.0, 30.0};
 struct Map {
   double gain = 0.0;
   double misalignment_rad = 0.0;
+  double phase_rad = 0.0;
 };
 
-// The measured sample: Y_meas = (1 + g)(cos2b Y + sin2b X), white noise on the
+// The measured sample: Y_meas = (1 + g) e^{-i phi}(cos2b Y + sin2b X), white noise on the
 // four quadratures, the correction the firmware applies (if any), wave
 // variables recomputed as the firmware does.
 WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt19937_64& rng,
@@ -37,8 +38,9 @@ WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt199
   const double s2b = std::sin(2.0 * m.misalignment_rad);
   const double cy = (1.0 + m.gain) * (c2b * q.cy + s2b * q.cx);
   const double sy = (1.0 + m.gain) * (c2b * q.sy + s2b * q.sx);
-  q.cy = cy;
-  q.sy = sy;
+  // Y e^{-i phi} with Y = cy - i sy.
+  q.cy = std::cos(m.phase_rad) * cy - std::sin(m.phase_rad) * sy;
+  q.sy = std::cos(m.phase_rad) * sy + std::sin(m.phase_rad) * cy;
   std::normal_distribution<double> n(0.0, noise_v);
   q.cx += n(rng);
   q.sx += n(rng);
@@ -49,16 +51,17 @@ WaveSample measure(const DecayState& s, const Map& m, double noise_v, std::mt199
   return WaveSample{s.t_s, w.a_A_v, w.a_B_v, w.theta_A_rad, w.E_v2};
 }
 
-// `windows` free decays of 1 s at 1 kHz, window w while the table turns at
-// rates_dps[w % n], each starting at the set point at a new pattern angle.
+// `count` free decays of 1 s at 1 kHz from window `first` on, window w while
+// the table turns at rates_dps[w % n], each starting at the set point at a new
+// pattern angle; the mean damping of window w is nu (1 + nu_wobble sin(w)).
 template <std::size_t N>
-PickoffSelfCalResult run_windows(const Map& m, const double (&rates_dps)[N], int windows,
-                                 double max_kappa = kSelfCalMaxKappa,
-                                 const hrg::dsp::PickoffCorrection<double>& applied = {}) {
-  const ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
-  PickoffSelfCalibration cal;
-  std::mt19937_64 rng(16);
-  for (int w = 0; w < windows; ++w) {
+void feed_windows(PickoffSelfCalibration& cal, const Map& m, const double (&rates_dps)[N],
+                  int first, int count, const hrg::dsp::PickoffCorrection<double>& applied = {},
+                  double nu_wobble = 0.0) {
+  std::mt19937_64 rng(16 + static_cast<unsigned>(first));
+  for (int w = first; w < first + count; ++w) {
+    ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
+    p(kNu) *= 1.0 + nu_wobble * std::sin(static_cast<double>(w));
     const SyntheticDecay decay(p, kK, rates_dps[static_cast<std::size_t>(w) % N] * kDeg);
     DecayState s{100.0 * w, 1.0, 1e-3, (13.0 * w) * kDeg};
     CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(cal.begin_window()));
@@ -68,6 +71,15 @@ PickoffSelfCalResult run_windows(const Map& m, const double (&rates_dps)[N], int
     }
     CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(cal.end_window()));
   }
+}
+
+template <std::size_t N>
+PickoffSelfCalResult run_windows(const Map& m, const double (&rates_dps)[N], int windows,
+                                 double max_kappa = kSelfCalMaxKappa,
+                                 const hrg::dsp::PickoffCorrection<double>& applied = {},
+                                 double nu_wobble = 0.0) {
+  PickoffSelfCalibration cal;
+  feed_windows(cal, m, rates_dps, 0, windows, applied, nu_wobble);
   return cal.solve(max_kappa);
 }
 
@@ -87,10 +99,11 @@ TEST(PickoffSelfCalibration, GainAndMisalignmentComeFromTheLevelWhileTheTableTur
       "\n  self-calibration, 40 windows at 0/100/-60/30 deg/s: g %.5f +- %.1e (truth 0.01), "
       "b %.4f +- %.4f deg (truth 0.5), kappa %.1f\n",
       r.gain, r.gain_sigma, r.misalignment_rad / kDeg, r.misalignment_sigma_rad / kDeg, r.kappa_2);
-  // First-order model: its bias is O(g^2, g b) ~ 1e-4; the firmware applies
-  // the correction and identifies what is left, which shrinks quadratically.
-  DOUBLES_EQUAL(truth.gain, r.gain, 3.0 * r.gain_sigma + 2e-4);
-  DOUBLES_EQUAL(truth.misalignment_rad, r.misalignment_rad, 3.0 * r.misalignment_sigma_rad + 2e-4);
+  // The model is exact in rho and bh, with the O(g^2) 8theta terms free:
+  // what is left is O(g^3) ~ 1e-6.
+  DOUBLES_EQUAL(truth.gain, r.gain, 3.0 * r.gain_sigma + 1e-6);
+  DOUBLES_EQUAL(truth.misalignment_rad, r.misalignment_rad, 3.0 * r.misalignment_sigma_rad + 1e-6);
+  CHECK_TRUE(r.decay_consistent);
   CHECK_TRUE(r.gain_sigma < 1e-4);
   // The damping terms solved alongside are the resonator's (seed: nu = pi f / Q,
   // dmu 0.05 at 20 deg): the gain mismatch is not taken for anisotropy.
@@ -102,8 +115,7 @@ TEST(PickoffSelfCalibration, GainAndMisalignmentComeFromTheLevelWhileTheTableTur
 
 TEST(PickoffSelfCalibration, AppliedAndIdentifiedAgainTheResidualMapVanishes) {
   // The firmware applies the identified inverse and keeps identifying on the
-  // corrected signals: what is left is the first pass's O(g^2) bias, which
-  // the second pass sees and removes.
+  // corrected signals: what is left is within the noise.
   const Map truth{0.01, 0.5 * kDeg};
   const PickoffSelfCalResult r1 = run_windows(truth, kMixedRates, 40);
   hrg::dsp::PickoffCorrection<double> k1;
@@ -126,6 +138,74 @@ TEST(PickoffSelfCalibration, AnIdealPickoffGivesZeroWithinItsSigma) {
   CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
   CHECK_TRUE(std::fabs(r.gain) < 4.0 * r.gain_sigma);
   CHECK_TRUE(std::fabs(r.misalignment_rad) < 4.0 * r.misalignment_sigma_rad);
+  CHECK_TRUE(std::fabs(r.phase_rad) < 4.0 * r.phase_sigma_rad);
+  CHECK_TRUE(r.decay_consistent);
+}
+
+TEST(PickoffSelfCalibration, ThePhaseLagComesFromTheQuadratureLevelWhileTheTableTurns) {
+  // phi puts a^2 phi sin4th into Q; within a turning window it follows the
+  // pattern angle, while the split grows the true quadrature (its integral).
+  const Map truth{0.0, 0.0, 1.0 * kDeg};
+  const PickoffSelfCalResult r = run_windows(truth, kMixedRates, 40);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
+  std::printf(
+      "\n  phase 1 deg: phi %.5f +- %.5f deg, split dw_C %.4e dw_S %.4e rad/s, kappa %.1f\n",
+      r.phase_rad / kDeg, r.phase_sigma_rad / kDeg, r.dw_c_rad_s, r.dw_s_rad_s, r.kappa_2_quad);
+  DOUBLES_EQUAL(truth.phase_rad, r.phase_rad, 3.0 * r.phase_sigma_rad + 1e-6);
+  CHECK_TRUE(r.phase_sigma_rad < 0.01 * kDeg);
+  // The split solved alongside is the resonator's (seed: dw = pi 5e-4 rad/s at 5 deg).
+  const ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
+  DOUBLES_EQUAL(p(kDwC), r.dw_c_rad_s, 0.01 * p(kDwC));
+  DOUBLES_EQUAL(p(kDwS), r.dw_s_rad_s, 0.01 * p(kDwC));
+  // E does not see the phase.
+  CHECK_TRUE(std::fabs(r.gain) < 4.0 * r.gain_sigma);
+  CHECK_TRUE(std::fabs(r.misalignment_rad) < 4.0 * r.misalignment_sigma_rad);
+}
+
+TEST(PickoffSelfCalibration, WindowsReReferredThroughTheAppliedCorrectionAllCount) {
+  // 20 windows identify the map, the firmware applies it, 20 more come
+  // through the correction: the re-referred state's residual comes from all
+  // 40 (its sigma that of 40), and the total is the truth.
+  const Map truth{0.01, 0.5 * kDeg, 0.5 * kDeg};
+  PickoffSelfCalibration cal;
+  feed_windows(cal, truth, kMixedRates, 0, 20);
+  const PickoffSelfCalResult r1 = cal.solve();
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r1.status));
+  cal.refer_to_applied(r1);
+  const PickoffSelfCalResult r0 = cal.solve();
+  // Right after: nothing left.
+  CHECK_TRUE(std::fabs(r0.gain) < 1e-9 && std::fabs(r0.misalignment_rad) < 1e-9 &&
+             std::fabs(r0.phase_rad) < 1e-9);
+  hrg::dsp::PickoffCorrection<double> k1;
+  CHECK_TRUE(hrg::dsp::pickoff_correction_of({r1.gain, r1.phase_rad, r1.misalignment_rad}, k1));
+  feed_windows(cal, truth, kMixedRates, 20, 20, k1);
+  const PickoffSelfCalResult r2 = cal.solve();
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r2.status));
+  const double g = (1.0 + r1.gain) * (1.0 + r2.gain) - 1.0;
+  const double b = r1.misalignment_rad + r2.misalignment_rad;
+  const double phi = r1.phase_rad + r2.phase_rad;
+  std::printf(
+      "\n  20 windows, applied, 20 more: g sigma %.1e -> %.1e; total g %.6f, b %.5f deg, phi "
+      "%.5f deg\n",
+      r1.gain_sigma, r2.gain_sigma, g, b / kDeg, phi / kDeg);
+  CHECK_TRUE(r2.gain_sigma < 0.8 * r1.gain_sigma);
+  CHECK_TRUE(std::fabs(g - truth.gain) < 3.0 * r2.gain_sigma + 2e-6);
+  CHECK_TRUE(std::fabs(b - truth.misalignment_rad) < 3.0 * r2.misalignment_sigma_rad + 2e-6);
+  // The quadrature row is first order: its cross terms (phi g, phi b) leave
+  // ~1e-3 deg here.
+  CHECK_TRUE(std::fabs(phi - truth.phase_rad) < 3.0 * r2.phase_sigma_rad + 0.002 * kDeg);
+}
+
+TEST(PickoffSelfCalibration, ADampingThatChangesBetweenWindowsFailsTheDecayTest) {
+  // An ideal pickoff, the mean damping 2 % different from window to window
+  // (temperature, amplitude): each window's slope departs from the common nu
+  // by 2 dnu ~ 1.3e-4 1/s, ~6 of its sigma. The per-window decay test sees it.
+  const PickoffSelfCalResult r = run_windows(Map{}, kMixedRates, 40, kSelfCalMaxKappa, {}, 0.02);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
+  std::printf("\n  nu +-2 %% between windows: decay F %.1f (limit %.2f), g %.1e +- %.1e\n",
+              r.decay_f, r.decay_f_limit, r.gain, r.gain_sigma);
+  CHECK_FALSE(r.decay_consistent);
+  CHECK_TRUE(r.decay_f > 2.0 * r.decay_f_limit);
 }
 
 TEST(PickoffSelfCalibration, WithoutWindowsAtDifferentRatesTheSolveIsRefused) {

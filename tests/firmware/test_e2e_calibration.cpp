@@ -4,6 +4,7 @@
 // agreed with it, and a calibration that makes the model check worse is
 // withdrawn, reported, and never stands behind a valid output.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <numbers>
 #include <string>
@@ -130,7 +131,10 @@ namespace {
 // The truth must lie within 5 sigma of what the firmware put in force: with
 // the last solve's residual when it was accepted (its sigma), else the last
 // applied estimate's sigma (the residual was removed with it).
-void check_in_force(const RunResult& r, double true_gain, double true_misalignment_rad) {
+// `phase_allowance_rad` is added to the phase's 5 sigma where a first-order
+// cross term of the quadrature row is known to remain.
+void check_in_force(const RunResult& r, double true_gain, double true_misalignment_rad,
+                    double true_phase_rad = 0.0, double phase_allowance_rad = 0.0) {
   const hrg::est::PickoffSelfCalResult& last = r.self_calibration;
   const hrg::est::PickoffSelfCalResult& applied = r.self_calibration_applied.applied;
   const bool last_ok = last.status == hrg::est::Status::ok;
@@ -141,6 +145,16 @@ void check_in_force(const RunResult& r, double true_gain, double true_misalignme
   const double sb = last_ok ? last.misalignment_sigma_rad : applied.misalignment_sigma_rad;
   DOUBLES_EQUAL(true_gain, g, 5.0 * sg);
   DOUBLES_EQUAL(true_misalignment_rad, b, 5.0 * sb);
+  const double phi = r.final_calibration.pickoff_y_phase_rad + (last_ok ? last.phase_rad : 0.0);
+  const double sp = last_ok ? last.phase_sigma_rad : applied.phase_sigma_rad;
+  DOUBLES_EQUAL(true_phase_rad, phi, 5.0 * sp + phase_allowance_rad);
+}
+
+// A temperature swing of +-amplitude_c at 5 mHz about the reference.
+RunConfig with_temperature_sine(RunConfig j, double amplitude_c) {
+  j.sim.temp_c = hrg::sim::Profile::sine(amplitude_c, 0.005, 0.0);
+  j.sim.temp_c.add_offset(j.sim.resonator.temp_ref_c);
+  return j;
 }
 
 // Do no harm: a compensation reported valid is never worse than raw.
@@ -173,10 +187,11 @@ TEST(CalibrationLoop, OnTheCleanGyroTheSelfCalibrationAppliesNothing) {
 TEST(CalibrationLoop, AGainMismatchIsFoundAndCorrectedOnline) {
   // GIVEN a 1 % y gain mismatch and no calibration file
   const RunResult r = run_scenario(self_calibrating(with_gain_mismatch(0.01)));
-  // THEN the firmware applies its own estimate (the first-order estimate,
-  // then its O(g^2) residual), and what is in force is the truth to within
-  // the identification's 5 sigma; the identification starts again on the
-  // corrected signals, and no worse-than-raw output is reported valid.
+  // THEN the firmware applies its own estimate, then the residual over every
+  // window (re-referred through the correction in force), and what is in
+  // force is the truth to within the identification's 5 sigma; the model
+  // starts again on the corrected signals, and no worse-than-raw output is
+  // reported valid.
   CHECK(r.self_calibration_applied.rounds >= 1);
   CHECK(r.calibration.source == CalibrationSource::online);
   CHECK(r.calibration.verdict != CalibrationVerdict::withdrawn);
@@ -192,6 +207,65 @@ TEST(CalibrationLoop, AMisalignmentIsFoundAndCorrectedOnline) {
   const RunResult r = run_scenario(self_calibrating(j));
   CHECK(r.self_calibration_applied.rounds >= 1);
   CHECK(r.calibration.source == CalibrationSource::online);
-  check_in_force(r, 0.0, 0.5 * std::numbers::pi / 180.0);
+  // The quadrature row is first order: the misalignment's cross terms (the
+  // measured pattern angle is off by b(1 + cos4th)/2, the quadrature level
+  // scaled by E's 2b sin4th) read as a phase of ~0.008 deg at 0.5 deg.
+  std::printf("\n  misalignment 0.5 deg online: %.5f deg in force, phase %.5f deg\n",
+              r.final_calibration.pickoff_y_misalignment_rad * 180.0 / std::numbers::pi,
+              r.final_calibration.pickoff_y_phase_rad * 180.0 / std::numbers::pi);
+  check_in_force(r, 0.0, 0.5 * std::numbers::pi / 180.0, 0.0, 0.012 * std::numbers::pi / 180.0);
+  check_no_harm(r);
+}
+
+TEST(CalibrationLoop, APhaseLagIsFoundAndCorrectedOnline) {
+  // GIVEN a 1 deg phase lag of the y pickoff chain and no calibration file
+  RunConfig j = default_scenario();
+  j.sim.effects.pickoff_phase_mismatch.enabled = true;
+  j.sim.effects.pickoff_phase_mismatch.phase_deg = 1.0;
+  const RunResult r = run_scenario(self_calibrating(j));
+  // THEN the quadrature's level pattern in the turning windows gives it:
+  // what is in force is the truth to within 5 sigma (gain and misalignment 0).
+  std::printf("\n  phase 1 deg online: %.5f deg in force after %u rounds\n",
+              r.final_calibration.pickoff_y_phase_rad * 180.0 / std::numbers::pi,
+              r.self_calibration_applied.rounds);
+  CHECK(r.self_calibration_applied.rounds >= 1);
+  CHECK(r.calibration.source == CalibrationSource::online);
+  check_in_force(r, 0.0, 0.0, std::numbers::pi / 180.0);
+  check_no_harm(r);
+}
+
+TEST(CalibrationLoop, ADampingThatFollowsTheTemperatureGetsNoPickoffTerms) {
+  // GIVEN an ideal pickoff and the damping following a +-1 degC swing at
+  // 0.4 %/degC (the Gregory table's thermal row): the windows' decay rates
+  // differ by up to 2.5e-5 1/s, which the common-nu fit reads as a gain of
+  // ~7e-5 (5 sigma)
+  RunConfig j = with_temperature_sine(default_scenario(), 1.0);
+  j.sim.effects.thermal_damping.enabled = true;
+  j.sim.effects.thermal_damping.rel_per_c = 0.004;
+  const RunResult r = run_scenario(self_calibrating(j));
+  // THEN the per-window decay test fails and nothing is applied.
+  std::printf("\n  thermal damping: decay F %.2f (limit %.2f), g %.1e +- %.1e\n",
+              r.self_calibration.decay_f, r.self_calibration.decay_f_limit, r.self_calibration.gain,
+              r.self_calibration.gain_sigma);
+  CHECK(r.self_calibration.status == hrg::est::Status::ok);
+  CHECK_FALSE(r.self_calibration.decay_consistent);
+  CHECK_EQUAL(0u, r.self_calibration_applied.rounds);
+  CHECK(r.calibration.source == CalibrationSource::none);
+  check_no_harm(r);
+}
+
+TEST(CalibrationLoop, ANonlinearDampingGetsNoPickoffTerms) {
+  // GIVEN an ideal pickoff and a damping growing with the amplitude
+  // (0.05 /V^2, the Gregory table's row)
+  RunConfig j = default_scenario();
+  j.sim.effects.nonlinear_damping.enabled = true;
+  j.sim.effects.nonlinear_damping.rel_per_v2 = 0.05;
+  const RunResult r = run_scenario(self_calibrating(j));
+  // THEN nothing is applied.
+  std::printf("\n  nonlinear damping: decay F %.2f (limit %.2f), g %.1e +- %.1e\n",
+              r.self_calibration.decay_f, r.self_calibration.decay_f_limit, r.self_calibration.gain,
+              r.self_calibration.gain_sigma);
+  CHECK_EQUAL(0u, r.self_calibration_applied.rounds);
+  CHECK(r.calibration.source == CalibrationSource::none);
   check_no_harm(r);
 }

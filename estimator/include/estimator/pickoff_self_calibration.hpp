@@ -1,30 +1,61 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-// Online identification of the pickoff gain mismatch g and misalignment b
-// from the estimator's own free-decay windows (docs/effects-catalog.md).
+// Online identification of the pickoff map (gain mismatch g, misalignment b,
+// phase lag phi; docs/effects-catalog.md) from the estimator's own
+// free-decay windows.
 //
-// Through the map Y_meas = (1 + g)(cos2b Y + sin2b X), a standing wave of
-// amplitude a at angle theta is measured with
-//     E_meas = a^2 [cos^2 2th + (1 + g)^2 sin^2(2th + 2b)]
-//           ~= a^2 [1 + g (1 - cos 4th) + 2b sin 4th]      (first order),
-// a 4theta pattern in the LEVEL of ln E. Damping anisotropy is a 4theta
-// pattern in the decay RATE instead (eq. 8 with a_B ~ 0: a_A' = -(nu + d) a_A,
-// d = dnu_C cos4th + dnu_S sin4th). Within window w:
-//     ln E(t) = c_w - 2 nu t - 2 dnu_C int cos4th dt - 2 dnu_S int sin4th dt
-//               - g cos4th + 2b sin4th.
-// The window's offset c_w (the amplitude it starts at, and the constant g)
-// is removed by centring every regressor within its window; the rest is one
-// least-squares problem in p = (nu, dnu_C, dnu_S, g, b) over all windows.
-// Observability: at rest the level pattern is constant within a window (its
-// regressors centre to zero); at one constant turn rate w the integrals of a
-// 4theta pattern are 4theta patterns themselves, so -4 g w sin4th looks
-// exactly like a damping anisotropy (the error the seed's method makes). g
-// and b separate from the anisotropy only with windows at different rates,
-// at rest included; the condition check refuses the solve otherwise. The
-// phase mismatch leaves E unchanged and is not seen here (it shows in the
-// quadrature). The model is first order: its bias is O(g^2, g b); applied
-// and identified again on the corrected signals, it shrinks quadratically.
+// Level of E. Through Y_meas = (1 + g) e^{-i phi}(cos2b Y + sin2b X) the
+// corrected energy is a linear form in the measured E, R, S (dsp/
+// pickoff_correction.hpp), so with r = R/E and s = S/E of the measured wave,
+// exactly,
+//     ln E_meas = ln E - ln(1 + rho r - 2 bh s) + const,
+//     rho = (k - 1)/(k + 1), k = (1 + g)^2,  bh = sin2b / (2 sqrt(1 - rho^2)):
+// a 4theta pattern in the LEVEL of ln E, and the O(g^2) part an 8theta one
+// (-ln(1 + u) = -u + u^2/2, u^2/2 = const + h_c cos8th + h_s sin8th). Damping
+// anisotropy is a 4theta pattern in the decay RATE instead (eq. 20:
+// (ln E)' = -2 nu - 2 dnu_C r - 2 dnu_S s). Within window w:
+//     ln E(t) = c_w - 2 nu t - 2 dnu_C int r - 2 dnu_S int s
+//               - rho r + 2 bh s + h_c (r^2 - s^2)/2 + h_s r s.
+// The window's offset c_w is removed by centring every column within the
+// window; the rest is one least-squares problem over all windows.
+//
+// Level of the quadrature. The phase lag puts Q_meas = 2(1 + g) a^2 cos2th
+// sin(2th + 2b) sin phi ~ a^2 phi sin4th into the quadrature reading, while
+// the split grows the true one (eq. 20: (2 a_B/a_A)' = 2 dw_C sin4th -
+// 2 dw_S cos4th):
+//     Q/E (t) = c'_w + 2 dw_C int sin4th - 2 dw_S int cos4th + phi sin4th.
+// The quadrature loop nulls Q_meas in operation, i.e. leaves a true
+// quadrature -phi a^2 sin4th that the window starts from (the constant c'_w);
+// within the window the level term follows the pattern angle. The quadrature
+// row is first order: the cross terms phi g, phi b (and b times the split
+// through the measured pattern angle) leave ~1e-3 deg at g 0.01, b 0.5 deg.
+//
+// Rows are block means (kSelfCalBlockSamples).
+//
+// Observability: at rest the level patterns are constant within a window
+// (their columns centre to zero); at one constant turn rate w the integrals
+// of a 4theta pattern are 4theta patterns themselves, so -4 rho w sin4th looks
+// exactly like a damping anisotropy (the error the seed's method makes), and
+// phi like a split. They separate only with windows at different rates, at
+// rest included; the condition check refuses the solve otherwise.
+//
+// The decay model's one nu is what makes the level pattern observable in a
+// turning window (the pattern's change within the window is mostly a slope):
+// a damping that differs between windows (temperature, amplitude) shifts
+// their slopes and, where it correlates with the windows' pattern angles,
+// reads as a gain or misalignment. The same normal equations with a decay
+// slope of their own per window (nu per window) test it: their residual
+// against the common-nu fit's, F = [(RSS_c - RSS_w)/(W - 1)] / [RSS_w/dof_w],
+// is ~1 when one nu holds; the result reports it (decay_f) and
+// decay_consistent says whether it passed (the firmware applies nothing
+// otherwise).
+//
+// A correction put in force changes the signals of the windows to come, not
+// those already folded: refer_to_applied() re-refers the accumulated normal
+// equations through it (the fitted pickoff pattern is subtracted from the
+// observations, exact in the linear model), so the estimate keeps all the
+// windows and reads as the residual of the correction in force.
 //
 // Fixed-size Eigen state, no heap, no exceptions: callable from the firmware.
 
@@ -34,12 +65,22 @@
 
 namespace hrg::est {
 
-inline constexpr int kSelfCalParams = 5;  // nu, dnu_C, dnu_S, g, b
+// Level-of-E columns: nu, dnu_C, dnu_S, rho, bh, h_c, h_s.
+inline constexpr int kSelfCalParams = 7;
+// Quadrature columns: dw_C, dw_S, phi.
+inline constexpr int kSelfCalQuadParams = 3;
+// Rows are means over blocks of this many samples (10 ms at 1 kHz, longer
+// than the demodulator's correlation): the residual then estimates the noise
+// the parameters see, and the decay test is not fooled by coloured noise.
+inline constexpr int kSelfCalBlockSamples = 10;
 // Largest condition number (Jacobi-scaled) a solve is accepted with.
 inline constexpr double kSelfCalMaxKappa = 1e4;
 // A window counts as turning when 4theta moved by at least this much (net,
 // so measurement noise does not add up): 0.1 rad is 1.4 deg of pattern angle.
 inline constexpr double kSelfCalMinTurnRad = 0.1;
+// The per-window decay test passes while F <= 1 + kSelfCalDecaySigmas *
+// sqrt(2 / (W - 1)) (F's standard deviation under one common nu, W windows).
+inline constexpr double kSelfCalDecaySigmas = 4.0;
 
 struct PickoffSelfCalResult {
   Status status = Status::no_data;
@@ -47,11 +88,21 @@ struct PickoffSelfCalResult {
   double gain_sigma = 0.0;        // 1 sigma, from the residual
   double misalignment_rad = 0.0;  // b (rad, physical)
   double misalignment_sigma_rad = 0.0;
+  double phase_rad = 0.0;  // phi: Y_meas = Y e^{-i phi} (rad)
+  double phase_sigma_rad = 0.0;
   double nu_per_s = 0.0;  // the damping terms solved alongside (1/s)
   double dnu_c_per_s = 0.0;
   double dnu_s_per_s = 0.0;
-  double kappa_2 = 0.0;       // condition number of the Jacobi-scaled normal matrix
-  double residual_rms = 0.0;  // of ln E
+  double level_8th_c = 0.0;  // h_c, h_s: the 8theta (O(g^2)) level terms of ln E
+  double level_8th_s = 0.0;
+  double dw_c_rad_s = 0.0;  // the split terms of the quadrature row (rad/s)
+  double dw_s_rad_s = 0.0;
+  double kappa_2 = 0.0;        // condition number of the level-of-E normal matrix (Jacobi-scaled)
+  double kappa_2_quad = 0.0;   // and of the quadrature one
+  double residual_rms = 0.0;   // of ln E
+  double decay_f = 0.0;        // the per-window decay test's F (1 when one nu holds)
+  double decay_f_limit = 0.0;  // what it passes up to
+  bool decay_consistent = false;
   int windows = 0;
   int turning_windows = 0;  // windows whose 4theta moved by kSelfCalMinTurnRad or more
   int samples = 0;
@@ -59,8 +110,11 @@ struct PickoffSelfCalResult {
 
 class PickoffSelfCalibration {
  public:
-  using Vec = Eigen::Matrix<double, kSelfCalParams, 1>;
-  using Mat = Eigen::Matrix<double, kSelfCalParams, kSelfCalParams>;
+  // Augmented state of one row type: [sum z z', sum z y; ., sum y y].
+  using AugE = Eigen::Matrix<double, kSelfCalParams + 1, kSelfCalParams + 1>;
+  using AugQ = Eigen::Matrix<double, kSelfCalQuadParams + 1, kSelfCalQuadParams + 1>;
+  using VecE = Eigen::Matrix<double, kSelfCalParams + 1, 1>;
+  using VecQ = Eigen::Matrix<double, kSelfCalQuadParams + 1, 1>;
 
   void reset();
   Status begin_window();
@@ -70,35 +124,52 @@ class PickoffSelfCalibration {
   void abort_window() { open_ = false; }
   // Folds the window into the normal equations (too_short below min_samples).
   Status end_window(int min_samples = 50);
-  // Solves; ill_conditioned when no window turned (g and b unseen) or when
-  // kappa_2 exceeds max_kappa (the windows' turn rates did not vary enough
-  // to tell g and b from the damping).
+  // Solves; ill_conditioned when no window turned (g, b, phi unseen) or when
+  // a kappa_2 exceeds max_kappa (the windows' turn rates did not vary enough
+  // to tell the level patterns from the damping and the split).
   PickoffSelfCalResult solve(double max_kappa = kSelfCalMaxKappa) const;
+  // The firmware has put `applied` (a solve's result) in force on top of the
+  // correction the windows so far were taken through: their observations are
+  // re-referred to the new correction (its fitted patterns subtracted), so
+  // later solves give the residual from every window. Not inside a window.
+  void refer_to_applied(const PickoffSelfCalResult& applied);
 
  private:
-  // Per-window raw sums of the regressors z and the observation y.
-  Vec sz_ = Vec::Zero();
-  Mat szz_ = Mat::Zero();
-  Vec szy_ = Vec::Zero();
-  double sy_ = 0.0;
-  double syy_ = 0.0;
-  int n_ = 0;
+  void fold_block();
+
+  // Per-window raw sums of [z, y] (level of E) and [zq, yq] (quadrature).
+  VecE se_ = VecE::Zero();
+  AugE see_ = AugE::Zero();
+  VecQ sq_ = VecQ::Zero();
+  AugQ sqq_ = AugQ::Zero();
+  VecE block_e_ = VecE::Zero();  // the block being summed
+  VecQ block_q_ = VecQ::Zero();
+  int in_block_ = 0;
+  int samples_in_window_ = 0;
+  int n_ = 0;  // blocks in the window
   bool open_ = false;
   double t0_ = 0.0;
+  double y0_ = 0.0;  // the window's first ln E (keeps the sums small)
   double last_t_ = 0.0;
+  double last_r_ = 0.0;
+  double last_s_ = 0.0;
   double last_c4_ = 0.0;
   double last_s4_ = 0.0;
+  double int_r_ = 0.0;
+  double int_s_ = 0.0;
   double int_c4_ = 0.0;
   double int_s4_ = 0.0;
   double last_4th_ = 0.0;
   double turn_4th_ = 0.0;  // net change of 4theta within the window
-  // Centred normal equations over the windows.
-  Mat hh_ = Mat::Zero();
-  Vec hy_ = Vec::Zero();
-  double yy_ = 0.0;
+  // Over the windows: centred (one nu), detrended (a nu per window),
+  // quadrature centred.
+  AugE ae_ = AugE::Zero();
+  AugE ad_ = AugE::Zero();
+  AugQ aq_ = AugQ::Zero();
   int windows_ = 0;
   int turning_ = 0;
   int samples_ = 0;
+  int blocks_ = 0;
 };
 
 }  // namespace hrg::est

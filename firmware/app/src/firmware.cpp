@@ -28,7 +28,20 @@ bool has_feedthrough(const Calibration& cal) {
 
 bool significant(const est::PickoffSelfCalResult& r, double n_sigma) {
   return std::fabs(r.gain) > n_sigma * r.gain_sigma ||
-         std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad;
+         std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad ||
+         std::fabs(r.phase_rad) > n_sigma * r.phase_sigma_rad;
+}
+
+// The estimate's information has grown by `factor` since `before` (every
+// parameter's variance divided by it at least).
+bool better_by(const est::PickoffSelfCalResult& r, const est::PickoffSelfCalResult& before,
+               double factor) {
+  const auto shrunk = [factor](double now, double then) {
+    return now * now * factor <= then * then;
+  };
+  return shrunk(r.gain_sigma, before.gain_sigma) &&
+         shrunk(r.misalignment_sigma_rad, before.misalignment_sigma_rad) &&
+         shrunk(r.phase_sigma_rad, before.phase_sigma_rad);
 }
 
 }  // namespace
@@ -62,23 +75,31 @@ void Firmware::self_calibrate() {
   // Once per fresh solve, never inside a window (the identifier restarts).
   if (r.samples == self_cal_samples_seen_ || gyro_.status().mode != Mode::operate) return;
   self_cal_samples_seen_ = r.samples;
-  if (r.status != est::Status::ok || !significant(r, kSelfCalSignificance) ||
-      self_cal_.rounds >= kMaxSelfCalRounds) {
+  // Nothing while one decay rate does not hold across the windows: a damping
+  // that changes between them reads as a level pattern.
+  if (r.status != est::Status::ok || !r.decay_consistent || self_cal_.rounds >= kMaxSelfCalRounds) {
     return;
   }
+  // First an estimate that stands out of its noise; then the residual of
+  // every window so far (re-referred through what is in force) whenever it
+  // stands out, or the information behind it has doubled.
+  const bool apply = significant(r, kSelfCalSignificance) ||
+                     (self_cal_.rounds > 0 && better_by(r, self_cal_.applied, 2.0));
+  if (!apply) return;
   // The estimate is the residual map seen through the correction in force:
-  // the gains compose, the misalignments add.
+  // the gains compose, the misalignments and the phases add.
   Calibration next = cfg_.calibration;
   next.pickoff_y_gain = (1.0 + next.pickoff_y_gain) * (1.0 + r.gain) - 1.0;
   next.pickoff_y_misalignment_rad += r.misalignment_rad;
+  next.pickoff_y_phase_rad += r.phase_rad;
   if (!apply_calibration(next, CalibrationSource::online)) return;
   ++self_cal_.rounds;
   self_cal_.applied = r;
   self_cal_.applied_s = gyro_.status().chain.t_s;
-  // Every window so far was taken through the old correction.
-  estimator_.restart();
+  // The model's windows were taken through the old correction: it starts
+  // again; the self-calibration keeps its windows, re-referred.
+  estimator_.restart_after_correction(r);
   gyro_.restart_identification();
-  self_cal_samples_seen_ = 0;
 }
 
 void Firmware::judge_calibration() {

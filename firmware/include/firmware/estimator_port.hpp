@@ -48,9 +48,11 @@ class EstimatorPort final : public ResonatorIdentifier {
   // The pickoff self-calibration over the same windows (campaign and check
   // windows alike): its last solve (re-solved after every window).
   const est::PickoffSelfCalResult& pickoff_self_calibration() const { return self_cal_result_; }
-  // Forgets every window (model, D_Phi, self-calibration): the signals they
-  // were taken on changed (a new pickoff correction).
-  void restart();
+  // A new pickoff correction (`applied`, a self-calibration result, on top of
+  // the one in force) changed the signals: the model and D_Phi forget every
+  // window; the self-calibration keeps them, re-referred through it
+  // (est::PickoffSelfCalibration::refer_to_applied).
+  void restart_after_correction(const est::PickoffSelfCalResult& applied);
   uint32_t windows_accepted() const { return windows_ok_; }
   uint32_t windows_rejected() const { return windows_bad_; }
   uint32_t solves_accepted() const { return solves_ok_; }

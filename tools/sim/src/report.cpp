@@ -192,6 +192,8 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.number("last_applied_gain_sigma", applied.applied.gain_sigma);
   w.number("last_applied_misalignment_deg", applied.applied.misalignment_rad / kDegRad);
   w.number("last_applied_misalignment_sigma_deg", applied.applied.misalignment_sigma_rad / kDegRad);
+  w.number("last_applied_phase_deg", applied.applied.phase_rad / kDegRad);
+  w.number("last_applied_phase_sigma_deg", applied.applied.phase_sigma_rad / kDegRad);
   w.number("last_applied_residual_rms", applied.applied.residual_rms);
   w.number("last_applied_kappa", applied.applied.kappa_2);
   // The last solve (after the last round: the residual left).
@@ -200,7 +202,14 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.number("gain_sigma", s.gain_sigma);
   w.number("misalignment_deg", s.misalignment_rad / kDegRad);
   w.number("misalignment_sigma_deg", s.misalignment_sigma_rad / kDegRad);
+  w.number("phase_deg", s.phase_rad / kDegRad);
+  w.number("phase_sigma_deg", s.phase_sigma_rad / kDegRad);
   w.number("kappa", s.kappa_2);
+  w.number("kappa_quad", s.kappa_2_quad);
+  // The per-window decay test (one nu across the windows: F ~ 1).
+  w.number("decay_f", s.decay_f);
+  w.number("decay_f_limit", s.decay_f_limit);
+  w.boolean("decay_consistent", s.decay_consistent);
   w.number("residual_rms", s.residual_rms);
   w.integer("windows", s.windows);
   w.integer("turning_windows", s.turning_windows);

@@ -12,7 +12,7 @@ namespace hrg::fw::app {
 
 // What the online pickoff self-calibration has put in force.
 struct SelfCalibrationStatus {
-  uint32_t rounds = 0;                  // estimates applied (each restarts the identification)
+  uint32_t rounds = 0;                  // estimates applied (each restarts the model)
   est::PickoffSelfCalResult applied{};  // the last one applied (the residual it removed)
   double applied_s = 0.0;               // when
 };
@@ -62,11 +62,13 @@ class Firmware {
   const Calibration& calibration() const { return cfg_.calibration; }
   const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  // An estimate is applied when its solve is accepted (conditioning) and it
-  // stands out of its own noise by this many sigma, at most kMaxSelfCalRounds
-  // times (each round removes the previous one's second-order residual).
+  // An estimate is applied when its solve is accepted (conditioning, one
+  // decay rate across the windows) and it stands out of its own noise by
+  // this many sigma; later, the residual over every window when it stands out
+  // or its information has doubled since the last one applied; at most
+  // kMaxSelfCalRounds times.
   static constexpr double kSelfCalSignificance = 5.0;
-  static constexpr uint32_t kMaxSelfCalRounds = 3;
+  static constexpr uint32_t kMaxSelfCalRounds = 4;
 
   void run_frame() {
     gyro_.run_frame();
