@@ -33,6 +33,7 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
     return false;
   }
   cfg_.calibration = cal;
+  estimator_.set_known_gap(cal.gap_eps_p, cal.gap_eps_q);
   guard_.applied(source, calibration_crc(cal), identity, gyro_.status().chain.t_s,
                  estimator_.health(), checking());
   return true;
@@ -71,6 +72,7 @@ void Firmware::judge_calibration() {
   // The chain goes back to the raw pickoffs; the verdict stays reported.
   chain_.clear_electronics_correction();
   cfg_.calibration = kIdentityCalibration;
+  estimator_.set_known_gap(0.0, 0.0);
 }
 
 }  // namespace hrg::fw::app

@@ -35,6 +35,12 @@ class EstimatorPort final : public ResonatorIdentifier {
   // Forgets every window (model, D_Phi, self-calibration): the signals they
   // were taken on changed (a new pickoff correction).
   void restart();
+  // The gap harmonic a calibration gives (both zero: not known, fitted
+  // online). Kept across restart(); changes no window.
+  void set_known_gap(double eps_p, double eps_q) {
+    cfg_.gap = {eps_p, eps_q};
+    est_.set_known_gap(cfg_.gap);
+  }
   uint32_t windows_accepted() const { return windows_ok_; }
   uint32_t windows_rejected() const { return windows_bad_; }
   uint32_t solves_accepted() const { return solves_ok_; }
