@@ -243,26 +243,29 @@ double pump_drive_v2(const ForcedSegment& f, const Params& p) {
 }
 }  // namespace
 
-double balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left) {
-  double num = 0.0, den = 0.0;
+PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left) {
+  // Weighted least squares of left = (c0 + c1 dlna) M over the segments.
+  double n00 = 0.0, n01 = 0.0, n11 = 0.0, r0 = 0.0, r1 = 0.0;
   for (std::size_t i = 0; i < d.forced.size(); ++i) {
     const ForcedSegment& f = d.forced[i];
     if (!(f.balance_sigma_per_s > 0.0)) continue;
     const double w = 1.0 / (f.balance_sigma_per_s * f.balance_sigma_per_s);
-    const double m = pump_drive_v2(f, p);
-    num += w * left[i] * m;
-    den += w * m * m;
+    const double m = pump_drive_v2(f, p), u = f.dlna_per_s * m;
+    n00 += w * m * m, n01 += w * m * u, n11 += w * u * u;
+    r0 += w * left[i] * m, r1 += w * left[i] * u;
   }
-  return den > 0.0 ? num / den : 0.0;
+  const double det = n00 * n11 - n01 * n01;
+  if (!(det > 1e-12 * n00 * n11)) return {n00 > 0.0 ? r0 / n00 : 0.0, 0.0};
+  return {(n11 * r0 - n01 * r1) / det, (n00 * r1 - n01 * r0) / det};
 }
 
 std::vector<double> balance_residuals(const Dataset& d, const Params& p) {
   std::vector<double> r;
   const std::vector<double> left = balance_left(d, p);
-  const double c = balance_pump_gain(d, p, left);
+  const PumpGain c = balance_pump_gain(d, p, left);
   for (std::size_t i = 0; i < d.forced.size(); ++i) {
     const ForcedSegment& f = d.forced[i];
-    if (f.balance_sigma_per_s > 0.0) r.push_back(left[i] - c * pump_drive_v2(f, p));
+    if (f.balance_sigma_per_s > 0.0) r.push_back(left[i] - c.at(f) * pump_drive_v2(f, p));
   }
   return r;
 }
@@ -270,9 +273,10 @@ std::vector<double> balance_residuals(const Dataset& d, const Params& p) {
 std::vector<double> angle_residuals(const Dataset& d, const Params& p) {
   std::vector<double> r;
   const std::vector<double> left = balance_left(d, p);
-  const double c = balance_pump_gain(d, p, left);
+  const PumpGain gain = balance_pump_gain(d, p, left);
   for (const auto& f : d.forced) {
     if (!(f.angle_sigma_rad_s > 0.0)) continue;
+    const double c = gain.at(f);
     const double dT = f.mean_temp_c - d.temp_ref_c;
     const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
     const double drift = s * (p[kDnuC] * f.mean_s4 - p[kDnuS] * f.mean_c4) +

@@ -90,12 +90,19 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p);
 // (the ring pump's in-phase force through the gap pattern G, seed eqs. 25-27;
 // s the damping scale of the thermal and nonlinear terms), per unit time. The
 // pump gain c is a nuisance, solved by weighted least squares inside every
-// evaluation. Empty unless the segments have their balance weights.
+// evaluation (with its change while the loop recovers, PumpGain). Empty
+// unless the segments have their balance weights.
 std::vector<double> balance_residuals(const Dataset& d, const Params& p);
-// The left side of the balance per segment (1/s) and the pump gain c of the
-// weighted fit (1/(s V^2)).
+// The left side of the balance per segment (1/s) and the pump gain of the
+// weighted fit (1/(s V^2)): c = c0 + c1 a_A'/a_A, the pump's efficiency
+// while the amplitude loop recovers from a window (its phase settling) is
+// not the one while it holds.
 std::vector<double> balance_left(const Dataset& d, const Params& p);
-double balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left);
+struct PumpGain {
+  double c0 = 0.0, c1 = 0.0;
+  double at(const ForcedSegment& f) const { return c0 + c1 * f.dlna_per_s; }
+};
+PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left);
 
 // Pattern-angle drift of the same segments (rad/s): measured
 // (theta1 - theta0)/(t1 - t0) against Omega K = -2 theta' + D (physics.md) with
