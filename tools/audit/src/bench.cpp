@@ -548,6 +548,24 @@ std::string format_rates(const BenchResult& r) {
                   bench::design_name(kind), hits, above, null_found, nulls);
     o += buf;
   }
+  o += "By effect (one effect above 2x; pairs and triples that hold it, all found):\n";
+  for (const auto& info : effect_table()) {
+    const int e = static_cast<int>(info.effect);
+    int hits = 0, above = 0, multi = 0, multi_found = 0;
+    for (const auto& c : r.cases) {
+      if (c.kind == CaseKind::single && c.truth == e && c.strength >= 2.0) {
+        ++above;
+        if (is_hit(c)) ++hits;
+      } else if ((c.kind == CaseKind::pair || c.kind == CaseKind::triple) &&
+                 std::find(c.truths.begin(), c.truths.end(), e) != c.truths.end()) {
+        ++multi;
+        if (c.all_found) ++multi_found;
+      }
+    }
+    std::snprintf(buf, sizeof buf, "  %-24s hits above 2x %d/%d, with others %d/%d\n", info.id,
+                  hits, above, multi_found, multi);
+    o += buf;
+  }
   return o;
 }
 
