@@ -27,6 +27,14 @@ ParamVector with_damping_scale(const ParamVector& p, double damping_scale) {
   return out;
 }
 
+double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad) {
+  const double s4 = std::sin(4.0 * theta_A_rad);
+  const double c4 = std::cos(4.0 * theta_A_rad);
+  const double kappa =
+      (p(kNu) + p(kDnuC) * c4 + p(kDnuS) * s4) / (1.0 + 0.5 * (eps_p * c4 + eps_q * s4));
+  return kappa * 0.5 * (eps_q * c4 - eps_p * s4);
+}
+
 double DriftCompensator::step(double theta_A_rad, double aB_over_aA, double d_phi_rad_s,
                               double dt_s) {
   const double d =
@@ -252,7 +260,9 @@ bool gap_harmonic(const Eigen::Matrix4d& m, Eigen::Vector2d& g) {
 }
 }  // namespace
 
-double PumpDriftEstimator::gap_sigmas() const {
+double PumpDriftEstimator::gap_sigmas() const { return gap_sigmas_from(Eigen::Vector2d::Zero()); }
+
+double PumpDriftEstimator::gap_sigmas_from(const Eigen::Vector2d& g0) const {
   if (!valid() || segments_ < 2 * kBatches) return 0.0;
   Eigen::Vector2d g;
   if (!gap_harmonic(m_, g)) return 0.0;
@@ -268,7 +278,8 @@ double PumpDriftEstimator::gap_sigmas() const {
   for (const Eigen::Vector2d& x : gb)
     cov += (x - mean) * (x - mean).transpose();
   cov /= static_cast<double>(kBatches) * (kBatches - 1);
-  const double m2 = g.dot(cov.ldlt().solve(g));
+  const Eigen::Vector2d dg = g - g0;
+  const double m2 = dg.dot(cov.ldlt().solve(dg));
   return m2 > 0.0 && std::isfinite(m2) ? std::sqrt(m2) : 0.0;
 }
 

@@ -37,6 +37,16 @@ void Estimator::check_window(const WindowContribution& w) {
   ++windows_checked_;
 }
 
+void Estimator::check_known_gap() {
+  if (!config_.gap.known() || gap_refuted_ || pump_.fit_s() == gap_checked_fit_s_) return;
+  gap_checked_fit_s_ = pump_.fit_s();
+  if (!pump_.valid()) return;
+  const double b0 = pump_.coefficients()(0);
+  const Eigen::Vector2d g0(0.5 * b0 * config_.gap.eps_p, 0.5 * b0 * config_.gap.eps_q);
+  const double min_sigmas = config_.pump.min_gap_sigmas;
+  if (min_sigmas > 0.0 && pump_.gap_sigmas_from(g0) >= min_sigmas) gap_refuted_ = true;
+}
+
 Solution Estimator::solve_and_accept() {
   last_ = ls_.solve(config_.variant);
   if (last_.accepted()) {

@@ -26,6 +26,8 @@ Calibration measured_gyro() {
   c.duffing_hz_per_v2 = 2e-3;
   c.electrostatic_spring_hz_per_v2 = -1.11e-4;
   c.nonlinear_damping_per_v2 = 0.05;
+  c.gap_eps_p = 0.02;
+  c.gap_eps_q = -0.01;
   return c;
 }
 
@@ -64,7 +66,7 @@ TEST(Calibration, EachFieldOutOfRangeIsNamedByItsIndex) {
 TEST(Calibration, CanonicalFormRoundTripsBitForBitAndItsCrcSeesEveryBit) {
   const Calibration c = measured_gyro();
   const CalibrationBytes b = serialize(c);
-  CHECK_EQUAL(105u, b.size());
+  CHECK_EQUAL(121u, b.size());
   CHECK_EQUAL(kCalibrationFormatVersion, b[0]);
   Calibration back;
   CHECK_TRUE(deserialize(b, back));

@@ -53,6 +53,8 @@ TEST(CalibrationFile, SavedFileLoadsBackToTheSameCalibrationAndItsCrc) {
   f.calibration.feedthrough_y_im_v_per_v = -4.33e-4;
   f.calibration.temperature_ref_c = 31.25;
   f.calibration.nonlinear_damping_per_v2 = 0.05;
+  f.calibration.gap_eps_p = -0.0198765;
+  f.calibration.gap_eps_q = 0.0101;
   f.sigma[2] = 0.002 * kDegToRad;
   const std::string path = "test_calibration_file_roundtrip.toml";
   save_calibration(path, f, {"header line"}, {"not correctable: something, because"});

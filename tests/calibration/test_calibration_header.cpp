@@ -21,4 +21,5 @@ TEST(CalibrationHeader, GeneratedConstantIsTheFilesCalibrationBitForBit) {
   CHECK_EQUAL(calibration_crc(f.calibration), calibration_crc(kBuiltInCalibration));
   DOUBLES_EQUAL(0.0101, kBuiltInCalibration.pickoff_y_gain, 0.0);
   static_assert(kBuiltInCalibration.temperature_ref_c == 31.5);
+  static_assert(kBuiltInCalibration.gap_eps_p == 0.0198);
 }

@@ -249,3 +249,29 @@ TEST(ControlDrift, PumpGapHarmonicsComeOutOfThePumpEffortOnSyntheticDecay) {
   est.restart();
   CHECK(est.valid());
 }
+
+TEST(ControlDrift, AKnownGapGivesThePumpsDriftAtTheAgcBalance) {
+  // GIVEN the resonator identified and a gap harmonic from a calibration
+  // (1/d0^3 ~ 1 + eps_p cos4th + eps_q sin4th; G's half-harmonics on the wave)
+  const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  const double eps_p = 0.02, eps_q = 0.01;
+  for (double th = 0.0; th < M_PI / 2; th += M_PI / 28) {
+    const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
+    // THEN with the pump holding a_A (eq. 3: a_A' = 0), the pump's growth
+    // rate balances the damping along the wave, kappa (1 + eps_p/2 c4 +
+    // eps_q/2 s4) = nu + dnu(th), and the drift is the pump's force across
+    // the wave: D_Phi = kappa (eps_q/2 c4 - eps_p/2 s4), ~ nu |eps| / 2.
+    const double kappa =
+        (p(kNu) + p(kDnuC) * c4 + p(kDnuS) * s4) / (1.0 + 0.5 * (eps_p * c4 + eps_q * s4));
+    const double d = known_gap_drift_rad_s(p, eps_p, eps_q, th);
+    DOUBLES_EQUAL(kappa * 0.5 * (eps_q * c4 - eps_p * s4), d, 1e-15);
+    CHECK(std::fabs(d) <= 1.1 * p(kNu) * std::hypot(eps_p, eps_q) / 2.0);
+  }
+  // AND the Estimator uses it only with a model, and not at all once zero
+  Estimator::Config cfg;
+  cfg.gap = {eps_p, eps_q};
+  Estimator e(cfg);
+  DOUBLES_EQUAL(0.0, e.pump_d_phi_rad_s(0.3), 0.0);
+  e.set_known_gap({0.0, 0.0});
+  CHECK_FALSE(e.known_gap().known());
+}

@@ -39,6 +39,17 @@ double resonator_drift_rad_s(const ParamVector& p, double theta_A_rad, double aB
 // referred to the present temperature and amplitude. The split is kept.
 ParamVector with_damping_scale(const ParamVector& p, double damping_scale);
 
+// D_Phi of the ring-electrode pump for a known gap harmonic (eps_p, eps_q),
+// the same physics as PumpDriftEstimator below with the gap given (a
+// calibration) instead of fitted. The AGC holds the amplitude, so the pump's
+// growth rate kappa balances the damping along the wave:
+//   kappa (1 + eps_p/2 cos4th + eps_q/2 sin4th) = nu + dnu_C cos4th + dnu_S sin4th
+// (the slow a_A'/a_A of the loop averages out), and then
+//   D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th).
+// Needs no pump gain and no fit of its own: right from the first model.
+// rad/s in Omega K units. Any context.
+double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad);
+
 // Integrates the modelled drift into an angle correction (input-axis radians).
 // Context: control-rate task. No heap.
 class DriftCompensator {
@@ -223,6 +234,9 @@ class PumpDriftEstimator {
   // understate it by ~10x). 0 before valid() or while a batch fit is
   // singular.
   double gap_sigmas() const;
+  // The same significance for (b1, b2) - g0: how far the fit stands from a
+  // gap harmonic given elsewhere (a calibration's, as b0 (eps_p, eps_q)/2).
+  double gap_sigmas_from(const Eigen::Vector2d& g0) const;
   static constexpr int kBatches = 8;
   // valid(), gap() >= Config::min_gap and gap_sigmas() >= Config::
   // min_gap_sigmas: the pump's D_Phi is worth adding.

@@ -58,6 +58,17 @@ class Estimator {
     ControlDriftEstimator::Config control{};
     PumpDriftEstimator::Config pump{};
     Forgetting forgetting{};
+    // The ring electrode's gap harmonic when a calibration gives it
+    // (eps_p, eps_q of docs/effects-catalog.md): the pump's part of D_Phi is
+    // then known_gap_drift_rad_s with the accepted model, from the first
+    // model on, instead of the online fit (which needs its own significance,
+    // minutes of excitation). Both zero: not known, the online fit is used.
+    struct KnownGap {
+      double eps_p = 0.0;
+      double eps_q = 0.0;
+      bool known() const { return eps_p != 0.0 || eps_q != 0.0; }
+    };
+    KnownGap gap{};
   };
 
   explicit Estimator(const Config& c)
@@ -95,6 +106,7 @@ class Estimator {
   bool add_control_sample(const ControlDriftEstimator::Sample& s) {
     const bool control_ok = control_.add_sample(s);
     const bool pump_ok = pump_.add_sample(s);
+    check_known_gap();
     return control_ok && pump_ok;
   }
   // Ends the D_Phi derivative blocks when the control samples stop for a
@@ -119,8 +131,29 @@ class Estimator {
   // each part only when it clears its own uncertainty (nothing is added
   // when there is nothing to find).
   double d_phi_rad_s(double theta_A_rad) const {
-    return control_.used_d_phi_rad_s() + (pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0);
+    return control_.used_d_phi_rad_s() + pump_d_phi_rad_s(theta_A_rad);
   }
+  // The ring pump's part of D_Phi: from the known gap (Config::gap) with the
+  // accepted model, else from the online fit once it is usable.
+  double pump_d_phi_rad_s(double theta_A_rad) const {
+    if (config_.gap.known() && !gap_refuted_) {
+      return has_model_
+                 ? known_gap_drift_rad_s(model_, config_.gap.eps_p, config_.gap.eps_q, theta_A_rad)
+                 : 0.0;
+    }
+    return pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0;
+  }
+  // A calibration's gap harmonic (both zero: not known). Keeps everything fitted.
+  // A new gap is on trial again (check_known_gap).
+  void set_known_gap(const Config::KnownGap& g) {
+    config_.gap = g;
+    gap_refuted_ = false;
+    gap_checked_fit_s_ = -1.0;
+  }
+  const Config::KnownGap& known_gap() const { return config_.gap; }
+  // The known gap disagreed with the online fit (do no harm): the pump's
+  // D_Phi is the online fit's again (when usable), for the rest of the run.
+  bool known_gap_refuted() const { return gap_refuted_; }
   const PumpDriftEstimator& pump_drift() const { return pump_; }
   const ControlDriftEstimator& control_drift() const { return control_; }
   Conditioning conditioning() const { return ls_.conditioning(); }
@@ -142,6 +175,13 @@ class Estimator {
   ControlDriftEstimator control_;
   PumpDriftEstimator pump_;
   void check_window(const WindowContribution& w);
+  // The known gap against the online fit, once per folded segment: refuted
+  // when the fit stands PumpDriftEstimator::Config::min_gap_sigmas of its own
+  // uncertainty away from it (a wrong sign stands out twice as fast as the
+  // gap itself becomes usable online).
+  void check_known_gap();
+  bool gap_refuted_ = false;
+  double gap_checked_fit_s_ = -1.0;
   void update_forgetting(const Solution& s);
   Solution anchor_{};
   double t_anchor_s_ = 0.0;

@@ -59,6 +59,7 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
   }
   cfg_.calibration = cal;
   estimator_.set_resonator_model(cal);
+  estimator_.set_known_gap(cal.gap_eps_p, cal.gap_eps_q);
   gyro_.restart_pump_edge_check();
   guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
                  has_feedthrough(cal),
@@ -110,6 +111,7 @@ void Firmware::judge_calibration() {
   cfg_.calibration = kIdentityCalibration;
   estimator_.set_resonator_model(kIdentityCalibration);
   gyro_.restart_pump_edge_check();
+  estimator_.set_known_gap(0.0, 0.0);
 }
 
 }  // namespace hrg::fw::app

@@ -53,6 +53,12 @@ class EstimatorPort final : public ResonatorIdentifier {
   // window; the self-calibration keeps them, re-referred through it
   // (est::PickoffSelfCalibration::refer_to_applied).
   void restart_after_correction(const est::PickoffSelfCalResult& applied);
+  // The gap harmonic a calibration gives (both zero: not known, fitted
+  // online). Kept across restart(); changes no window.
+  void set_known_gap(double eps_p, double eps_q) {
+    cfg_.gap = {eps_p, eps_q};
+    est_.set_known_gap(cfg_.gap);
+  }
   uint32_t windows_accepted() const { return windows_ok_; }
   uint32_t windows_rejected() const { return windows_bad_; }
   uint32_t solves_accepted() const { return solves_ok_; }

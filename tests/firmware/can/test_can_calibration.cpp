@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The guarded calibration write over CAN: the whole exchange, and every
 // refusal path changing nothing and being counted.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <vector>
@@ -15,6 +16,10 @@ using namespace hrg::fw::can;
 using hrg::hal::CanFrame;
 
 namespace {
+
+constexpr uint16_t kBlockBytes = static_cast<uint16_t>(kCalibrationBytes);
+constexpr unsigned kDataFrames =
+    (kCalibrationBytes + kCalDataBytesPerFrame - 1) / kCalDataBytesPerFrame;
 
 CalTransferConfig config() {
   CalTransferConfig c;
@@ -58,10 +63,12 @@ struct Rig {
     send(encode_cal_key(calibration_key(seed.value, secret)));
     return last();
   }
-  void send_data(const CalibrationBytes& b, unsigned from_frame = 0, unsigned to_frame = 15) {
+  void send_data(const CalibrationBytes& b, unsigned from_frame = 0,
+                 unsigned to_frame = kDataFrames) {
     for (unsigned k = from_frame; k < to_frame; ++k) {
-      const CalTransferOutcome o =
-          send(encode_cal_data(static_cast<uint8_t>(k), b.data() + 7 * k, kCalDataBytesPerFrame));
+      const unsigned at = kCalDataBytesPerFrame * k;
+      const unsigned n = std::min<unsigned>(kCalDataBytesPerFrame, kCalibrationBytes - at);
+      const CalTransferOutcome o = send(encode_cal_data(static_cast<uint8_t>(k), b.data() + at, n));
       if (o.reply_ready) return;
       now_ms += 1;
     }
@@ -124,19 +131,19 @@ TEST(CalibrationTransfer, GuardedWriteAppliesTheBlockAndRelocks) {
   CHECK_EQUAL(replies_before + 2, rig.replies.size());
   // One write per unlock.
   CHECK_FALSE(rig.gyro.unlocked());
-  rig.send(encode_cal_start(105, calibration_crc(c)));
+  rig.send(encode_cal_start(kBlockBytes, calibration_crc(c)));
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
   // Bus time of the whole exchange (classic frames, worst-case stuffing).
   auto bits = [](unsigned dlc) {
     const unsigned stuffed = 34 + 8 * dlc;
     return stuffed + (stuffed - 1) / 4 + 13;
   };
-  const unsigned total =
-      bits(1) + bits(7) + bits(5) + bits(7) + bits(7) + bits(7) + 15 * bits(8) + bits(1) + bits(7);
+  const unsigned total = bits(1) + bits(7) + bits(5) + bits(7) + bits(7) + bits(7) +
+                         kDataFrames * bits(8) + bits(1) + bits(7);
   std::printf(
-      "\n  guarded write: 4 control + 15 data frames + 4 replies, %u bits = %.2f ms at"
+      "\n  guarded write: 4 control + %u data frames + 4 replies, %u bits = %.2f ms at"
       " 1 Mbit/s (event traffic; the cyclic bus load is unchanged)\n",
-      total, total / 1000.0);
+      kDataFrames, total, total / 1000.0);
 }
 
 TEST(CalibrationTransfer, OutsideTheServiceModeEverythingIsRefusedAndAnOpenBlockDropped) {
@@ -150,7 +157,7 @@ TEST(CalibrationTransfer, OutsideTheServiceModeEverythingIsRefusedAndAnOpenBlock
   rig.unlock();
   const Calibration c = new_calibration();
   const CalibrationBytes b = serialize(c);
-  rig.send(encode_cal_start(105, calibration_crc(c)));
+  rig.send(encode_cal_start(kBlockBytes, calibration_crc(c)));
   rig.send_data(b, 0, 5);
   CanFrame reply;
   CHECK_TRUE(rig.gyro.tick(rig.now_ms, Mode::ring_up, reply));
@@ -158,7 +165,7 @@ TEST(CalibrationTransfer, OutsideTheServiceModeEverythingIsRefusedAndAnOpenBlock
   CHECK_TRUE(decode_cal_reply(reply, r));
   CHECK_EQUAL(static_cast<int>(CalResult::stale), static_cast<int>(r.result));
   CHECK_EQUAL(35, r.detail);  // bytes received
-  rig.send_data(b, 5, 15);
+  rig.send_data(b, 5, kDataFrames);
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
   rig.send(encode_cal_end());
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
@@ -172,7 +179,7 @@ TEST(CalibrationTransfer, WithoutUnlockNothingOpens) {
   const Calibration c = new_calibration();
   rig.send(encode_cal_key(0x12345678));  // no seed asked
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
-  rig.send(encode_cal_start(105, calibration_crc(c)));
+  rig.send(encode_cal_start(kBlockBytes, calibration_crc(c)));
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
   const CalibrationBytes b = serialize(c);
   rig.send(encode_cal_data(0, b.data(), 7));
@@ -183,7 +190,7 @@ TEST(CalibrationTransfer, WithoutUnlockNothingOpens) {
   // An unlock not used within unlock_timeout_ms lapses.
   rig.unlock();
   rig.now_ms += config().unlock_timeout_ms + 1;
-  rig.send(encode_cal_start(105, calibration_crc(c)));
+  rig.send(encode_cal_start(kBlockBytes, calibration_crc(c)));
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
   rig.expect_unchanged();
 }
@@ -251,7 +258,7 @@ TEST(CalibrationTransfer, PartialOutOfOrderOrStaleBlocksChangeNothing) {
   Rig rig;
   // A gap in the sequence drops the block.
   rig.unlock();
-  rig.send(encode_cal_start(105, crc));
+  rig.send(encode_cal_start(kBlockBytes, crc));
   rig.send_data(b, 0, 3);
   rig.send(encode_cal_data(4, b.data() + 28, 7));
   CHECK_EQUAL(static_cast<int>(CalResult::bad_sequence), result_of(rig.last()));
@@ -260,21 +267,21 @@ TEST(CalibrationTransfer, PartialOutOfOrderOrStaleBlocksChangeNothing) {
   CHECK_EQUAL(static_cast<int>(CalResult::locked), result_of(rig.last()));
   // END before the last frame.
   rig.unlock();
-  rig.send(encode_cal_start(105, crc));
-  rig.send_data(b, 0, 14);
+  rig.send(encode_cal_start(kBlockBytes, crc));
+  rig.send_data(b, 0, kDataFrames - 1);
   rig.send(encode_cal_end());
   CHECK_EQUAL(static_cast<int>(CalResult::incomplete), result_of(rig.last()));
-  CHECK_EQUAL(98, rig.last().detail);
+  CHECK_EQUAL(static_cast<int>(kCalDataBytesPerFrame * (kDataFrames - 1)), rig.last().detail);
   // A frame after frame_timeout_ms: the block is stale.
   rig.unlock();
-  rig.send(encode_cal_start(105, crc));
+  rig.send(encode_cal_start(kBlockBytes, crc));
   rig.send_data(b, 0, 10);
   rig.now_ms += config().frame_timeout_ms + 1;
-  rig.send_data(b, 10, 15);
+  rig.send_data(b, 10, kDataFrames);
   CHECK_EQUAL(static_cast<int>(CalResult::stale), result_of(rig.last()));
   // The same silence noticed by the tick.
   rig.unlock();
-  rig.send(encode_cal_start(105, crc));
+  rig.send(encode_cal_start(kBlockBytes, crc));
   rig.send_data(b, 0, 10);
   CanFrame reply;
   const uint32_t last_frame_ms = rig.now_ms - 1;

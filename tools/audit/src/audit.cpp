@@ -31,11 +31,48 @@ constexpr double kRadToDeg = 180.0 / kPi;
 // standard deviations of its own estimate above zero (and never below the
 // strength at which its delta BIC turns positive).
 constexpr double kDetectionSigmas = 5.0;
+// Floor of the amplitude balance's scatter, relative to the mean damping nu
+// (Auditor::weight_balance).
+constexpr double kBalanceFloor = 1e-4;
+// Floor of the pattern-angle drift's scatter (Auditor::weight_angle), rad.
+constexpr double kAngleFloor = 1e-6;
+// Segments the balance and the angle drift need: their scatter beyond the
+// noise is measured after three shapes are fitted, and with fewer than 7
+// degrees of freedom it is not known to within a factor of two (a recording
+// of six held segments then shows any control-force residual as a gap).
+constexpr std::size_t kBalanceMinSegments = 10;
+// Largest |a_A'/a_A| of a segment in the balance, relative to nu. Held
+// (kBalanceHeld): the amplitude control holds the wave at its set point;
+// these alone when there are enough of them. Recovering from a window
+// (0.15-0.25 nu on the default run) the firmware's pump phase is still
+// settling and its efficiency c is 7 % lower than held (PumpGain's c1 takes
+// that up, less well: on the default run's gap row the file then gives 1.26
+// deg/h against 0.94 from the held segments alone); beyond kBalanceHold the
+// wave rings up with the pump saturated, never used.
+constexpr double kBalanceHeld = 0.05;
+constexpr double kBalanceHold = 0.5;
 
-// Model parameter of each effect (-1: the edge statistic instead).
+// Model parameter of each effect (-1: the edge statistic instead); the gap
+// harmonics have a second one (second_param_of).
 int param_of(Effect e) {
-  static constexpr int kMap[kEffectCount] = {kGain, kPhase, kMis, kDuff, kNld, kTf, kTd, kEs, -1};
+  static constexpr int kMap[kEffectCount] = {kGain, kPhase, kMis, kDuff, kNld,
+                                             kTf,   kTd,    kEs,  -1,    kGapP};
   return kMap[static_cast<int>(e)];
+}
+int second_param_of(Effect e) { return e == Effect::gap_harmonics ? kGapQ : -1; }
+int n_params_of(Effect e) { return second_param_of(e) >= 0 ? 2 : 1; }
+
+// The mask with the effect's parameters on (or off).
+Mask with_effect(Mask m, Effect e, bool on = true) {
+  for (int i : {param_of(e), second_param_of(e)})
+    if (i >= 0) m[static_cast<std::size_t>(i)] = on;
+  return m;
+}
+// The parameters with the effect's set to zero.
+Params without_effect(Params p, Effect e) {
+  for (int i : {param_of(e), second_param_of(e)})
+    if (i >= 0) p[static_cast<std::size_t>(i)] = 0.0;
+  return p;
 }
 
 // Internal parameter -> catalogue unit.
@@ -44,6 +81,19 @@ double to_catalogue(Effect e, double v) {
     return v * kRadToDeg;
   }
   return v;
+}
+
+// The effect's value in catalogue units (a two-parameter effect: its magnitude).
+double effect_value(Effect e, const Params& p) {
+  const int j = second_param_of(e);
+  const double v = to_catalogue(e, p[static_cast<std::size_t>(param_of(e))]);
+  return j < 0 ? v : std::hypot(v, to_catalogue(e, p[static_cast<std::size_t>(j)]));
+}
+// Its 1-sigma (the magnitude's: the larger of the components' sigmas).
+double effect_sigma(Effect e, const Params& sigma) {
+  const int j = second_param_of(e);
+  const double v = std::abs(to_catalogue(e, sigma[static_cast<std::size_t>(param_of(e))]));
+  return j < 0 ? v : std::max(v, std::abs(to_catalogue(e, sigma[static_cast<std::size_t>(j)])));
 }
 
 struct State {
@@ -118,6 +168,8 @@ class Auditor {
   State fit_baseline(AuditResult& out);
   State adopt_block_noise(const Mask& base, State cur, AuditResult& out);
   State weight_forced_segments(const Mask& base, State cur);
+  void weight_balance();
+  void weight_angle(const std::vector<std::size_t>& use);
   void describe_data(AuditResult& out) const;
   std::vector<Candidate> score_candidates(const State& cur, const std::vector<Chosen>& chosen,
                                           bool first_step, AuditResult& out);
@@ -143,6 +195,7 @@ class Auditor {
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
   double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
+  Params start_balance_{};  // the free-decay baseline the balance starts from
 };
 
 bool Auditor::testable(Effect e) const {
@@ -152,6 +205,10 @@ bool Auditor::testable(Effect e) const {
     case Effect::electrostatic_spring:
       return d_.has_pump && d_.forced.size() >= 3 && eo_.use_forced;
     case Effect::drive_feedthrough: return d_.edges.size() >= 3;
+    case Effect::gap_harmonics:
+      return d_.has_pump && eo_.use_forced &&
+             std::any_of(d_.forced.begin(), d_.forced.end(),
+                         [](const ForcedSegment& f) { return f.balance_sigma_per_s > 0.0; });
     default: return true;
   }
 }
@@ -326,8 +383,10 @@ State Auditor::adopt_block_noise(const Mask& base, State cur, AuditResult& out) 
   if (lambda <= 1.2) return cur;
   const double f = std::sqrt(lambda);
   d_.noise_v *= f;
-  for (auto& fs : d_.forced)
+  for (auto& fs : d_.forced) {
     fs.se_rad_s *= f;
+    fs.balance_se_per_s *= f;
+  }
   char buf[160];
   std::snprintf(buf, sizeof buf,
                 "noise is correlated over samples: block noise %.2f x the white level of the "
@@ -343,6 +402,7 @@ State Auditor::adopt_block_noise(const Mask& base, State cur, AuditResult& out) 
 // amplitude squared, temperature), so that the signature of an effect is not
 // counted as noise; with few segments only the pump term is taken out.
 State Auditor::weight_forced_segments(const Mask& base, State cur) {
+  start_balance_ = cur.fit.p;
   const auto fr = forced_residuals(d_, cur.fit.p);
   const std::size_t n = fr.size();
   const int p = n >= 8 ? 3 : 1;
@@ -364,8 +424,102 @@ State Auditor::weight_forced_segments(const Mask& base, State cur) {
       rss / static_cast<double>(std::max<std::size_t>(1, n - static_cast<std::size_t>(p))) - se2);
   for (auto& f : d_.forced)
     f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
+  weight_balance();
   eo_.use_forced = true;
   return fit_state(base, cur.fit.p, false);
+}
+
+// Weight of each segment's amplitude balance (model.hpp): its white-noise
+// error and the scatter the baseline leaves beyond it once the shapes the
+// pump can have are taken out (c V^2 and the gap's c V^2 cos/sin 4 theta), so
+// that a gap harmonic is not counted as noise. That scatter comes from the
+// ends of a segment (the amplitude loop's state when the window cuts it), so
+// it is taken as e / T per segment of length T, e from the fit weighted by T;
+// e has a floor of kBalanceFloor nu x 1 s. Only segments where the amplitude
+// control holds the wave (|a_A'/a_A| <= kBalanceHeld nu) when there are
+// kBalanceMinSegments of them, else those that recover (<= kBalanceHold nu).
+void Auditor::weight_balance() {
+  if (!d_.has_pump) return;
+  const double nu = start_balance_[kNu];
+  auto segments_within = [&](double hold) {
+    std::vector<std::size_t> use;
+    for (std::size_t i = 0; i < d_.forced.size(); ++i) {
+      const auto& f = d_.forced[i];
+      if (f.mean_v2 > 0.0 && std::abs(f.dlna_per_s) <= hold * nu) use.push_back(i);
+    }
+    return use;
+  };
+  std::vector<std::size_t> use = segments_within(kBalanceHeld);
+  if (use.size() < kBalanceMinSegments) use = segments_within(kBalanceHold);
+  const std::size_t n = use.size();
+  if (n < kBalanceMinSegments) return;
+  const std::vector<double> left = balance_left(d_, start_balance_);
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 4);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  double se2 = 0.0;  // the white noise's share of the weighted scatter
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& f = d_.forced[use[k]];
+    const auto r = static_cast<Eigen::Index>(k);
+    const double t = f.t1_s - f.t0_s;
+    h(r, 0) = t * f.mean_v2, h(r, 1) = t * f.mean_v2c4, h(r, 2) = t * f.mean_v2s4;
+    h(r, 3) = t * f.dlna_per_s * f.mean_v2;
+    y(r) = t * left[use[k]];
+    se2 += t * t * f.balance_se_per_s * f.balance_se_per_s / static_cast<double>(n);
+  }
+  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+  const double rss = (y - h * coef).squaredNorm();
+  const double floor = kBalanceFloor * nu * 1.0;
+  const double e2 = std::max(floor * floor, rss / static_cast<double>(n - 4) - se2);
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    std::fprintf(stderr, "balance: %zu segments, e %.3g (floor %.3g), se2 %.3g\n", n, std::sqrt(e2),
+                 floor, se2);
+    for (std::size_t i : use) {
+      const auto& f = d_.forced[i];
+      std::fprintf(stderr, "  %.2f-%.2f dlna %.3g L/v2 %.5g c4 %.2f s4 %.2f\n", f.t0_s, f.t1_s,
+                   f.dlna_per_s, left[i] / f.mean_v2, f.mean_c4, f.mean_s4);
+    }
+  }
+  for (std::size_t i : use) {
+    auto& f = d_.forced[i];
+    const double t = f.t1_s - f.t0_s;
+    f.balance_sigma_per_s = std::sqrt(f.balance_se_per_s * f.balance_se_per_s + e2 / (t * t));
+  }
+  weight_angle(use);
+}
+
+// Weight of the pattern-angle drift of the same segments, the same way: the
+// scatter beyond the white noise once the gap's shapes (c V^2 cos/sin 4
+// theta) and an error of K (the mean rate) are taken out, as e / T, e from
+// the fit weighted by T, with a floor of kAngleFloor rad.
+void Auditor::weight_angle(const std::vector<std::size_t>& use) {
+  for (std::size_t i : use)
+    d_.forced[i].angle_sigma_rad_s = 1.0;  // marks the segments angle_residuals() takes
+  const std::vector<double> r = angle_residuals(d_, start_balance_);
+  const std::size_t n = use.size();
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 3);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  double se2 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& f = d_.forced[use[k]];
+    const auto row = static_cast<Eigen::Index>(k);
+    const double t = f.t1_s - f.t0_s;
+    h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.mean_rate_rad_s;
+    y(row) = t * r[k];
+    se2 += t * t * f.angle_se_rad_s * f.angle_se_rad_s / static_cast<double>(n);
+  }
+  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+  const double rss = (y - h * coef).squaredNorm();
+  const double e2 = std::max(kAngleFloor * kAngleFloor, rss / static_cast<double>(n - 3) - se2);
+  if (std::getenv("HRG_AUDIT_DEBUG"))
+    std::fprintf(stderr, "angle: e %.3g rad, se2 %.3g\n", std::sqrt(e2), se2);
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& f = d_.forced[use[k]];
+    const double t = f.t1_s - f.t0_s;
+    f.angle_sigma_rad_s = std::sqrt(f.angle_se_rad_s * f.angle_se_rad_s + e2 / (t * t));
+    if (std::getenv("HRG_AUDIT_DEBUG"))
+      std::fprintf(stderr, "  %.2f-%.2f angle res %.3g sigma %.3g c4 %.2f s4 %.2f\n", f.t0_s,
+                   f.t1_s, r[k], f.angle_sigma_rad_s, f.mean_c4, f.mean_s4);
+  }
 }
 
 void Auditor::describe_data(AuditResult& out) const {
@@ -404,17 +558,14 @@ std::vector<Candidate> Auditor::score_candidates(const State& cur,
       }
       continue;
     }
-    Mask m = cur.mask;
-    const auto pi = static_cast<std::size_t>(param_of(e));
-    m[pi] = true;
-    State s = fit_state(m, cur.fit.p, cur.feedthrough);
-    const double dbic = delta_bic(cur, s, 1);
-    const double sig = to_catalogue(e, s.fit.sigma[pi]) / std::sqrt(s.kappa);
+    State s = fit_state(with_effect(cur.mask, e), cur.fit.p, cur.feedthrough);
+    const double dbic = delta_bic(cur, s, n_params_of(e));
+    const double sig = effect_sigma(e, s.fit.sigma) / std::sqrt(s.kappa);
+    const double value = effect_value(e, s.fit.p);
     if (first_step) {
-      out.candidates.push_back({e, true, to_catalogue(e, s.fit.p[pi]), std::abs(sig), dbic,
+      out.candidates.push_back({e, true, value, std::abs(sig), dbic,
                                 std::abs(sig) * std::max(kDetectionSigmas, std::sqrt(ln_neff(s)))});
     }
-    const double value = to_catalogue(e, s.fit.p[pi]);
     cands.push_back({e, std::move(s), dbic, value, sig});
   }
   std::sort(cands.begin(), cands.end(),
@@ -430,10 +581,8 @@ void Auditor::retest_runner_up(const std::vector<Candidate>& cands, AuditResult&
     return;
   const Candidate& win = cands[0];
   const Candidate& ru = cands[1];
-  Mask m = win.s.mask;
-  m[static_cast<std::size_t>(param_of(ru.e))] = true;
-  const State s2 = fit_state(m, win.s.fit.p, false);
-  if (delta_bic(win.s, s2, 1) > opt_.min_delta_bic) return;
+  const State s2 = fit_state(with_effect(win.s.mask, ru.e), win.s.fit.p, false);
+  if (delta_bic(win.s, s2, n_params_of(ru.e)) > opt_.min_delta_bic) return;
   out.alternatives.push_back({ru.e, ru.value, ru.dbic,
                               "explains the same mismatch almost as well; not needed once "
                               "the first is in"});
@@ -641,15 +790,11 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
     double worst_dbic = 1e300;
     State worst_without;
     for (std::size_t k = 0; k < chosen.size(); ++k) {
-      const int pi = param_of(chosen[k].effect);
-      if (pi < 0) continue;
-      const auto i = static_cast<std::size_t>(pi);
-      Mask m = full.mask;
-      m[i] = false;
-      Params q = full.fit.p;
-      q[i] = 0.0;
-      State without = fit_state(m, q, false);
-      const double unique_dbic = delta_bic(without, full, 1);
+      const Effect e = chosen[k].effect;
+      if (param_of(e) < 0) continue;
+      State without =
+          fit_state(with_effect(full.mask, e, false), without_effect(full.fit.p, e), false);
+      const double unique_dbic = delta_bic(without, full, n_params_of(e));
       chosen[k].unique_dchi = delta_chi2(without, full);
       chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
       chosen[k].unique_checked = true;
@@ -659,8 +804,8 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
     if (worst == chosen.size() || worst_dbic >= opt_.min_delta_bic) return full;
     const Chosen& c = chosen[worst];
     out.alternatives.push_back(
-        {c.effect, to_catalogue(c.effect, full.fit.p[static_cast<std::size_t>(param_of(c.effect))]),
-         c.dbic, "not needed once the other accepted effects and the description are in"});
+        {c.effect, effect_value(c.effect, full.fit.p), c.dbic,
+         "not needed once the other accepted effects and the description are in"});
     chosen.erase(chosen.begin() + static_cast<std::ptrdiff_t>(worst));
     full = std::move(worst_without);
   }
@@ -680,9 +825,8 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
     const char* why = nullptr;
     double value = std::max(ft.c_x, ft.c_y), sigma = ft.sigma;
     if (pi >= 0) {
-      const auto i = static_cast<std::size_t>(pi);
-      value = to_catalogue(c.effect, full.fit.p[i]);
-      sigma = std::abs(to_catalogue(c.effect, full.fit.sigma[i]));
+      value = effect_value(c.effect, full.fit.p);
+      sigma = effect_sigma(c.effect, full.fit.sigma);
       if (!opt_.ar_whitening) {
         sigma /= std::sqrt(full.kappa);
       } else if (c.unique_dchi >= 0.0) {
@@ -722,6 +866,12 @@ void Auditor::claim_findings(const State& cur, const std::vector<Chosen>& chosen
     f.explains_fraction = c.fraction;
     if (c.effect == Effect::drive_feedthrough)
       f.feedthrough_re_im = feedthrough_stat(d_, cur.fit.p, ln_neff(cur)).c_re_im;
+    if (c.effect == Effect::gap_harmonics) {
+      // The components with the finding's sigma shared in their own proportion.
+      const double k = c.sigma / std::max(effect_sigma(c.effect, cur.fit.sigma), 1e-300);
+      f.gap_eps_pq_sigma = {cur.fit.p[kGapP], cur.fit.p[kGapQ], k * cur.fit.sigma[kGapP],
+                            k * cur.fit.sigma[kGapQ]};
+    }
     f.heldout_rms_before_v = out.heldout_rms_v;
     f.heldout_rms_after_v = out.heldout_rms_final_v;
     f.impact = impact_text(d_, cur.fit.p, c.effect, f.value);

@@ -58,6 +58,13 @@ void conceal(Scenario& s, Effect e, double v, std::mt19937_64& g) {
       fx.drive_feedthrough.y_phase_deg = 360.0 * u(g);
       break;
     }
+    case Effect::gap_harmonics: {
+      // |eps| = |v| along a drawn direction of the 4 theta circle.
+      const double dir = 2.0 * kPi * u(g);
+      s.electrodes.eps_p = std::abs(v) * std::cos(dir);
+      s.electrodes.eps_q = std::abs(v) * std::sin(dir);
+      break;
+    }
   }
 }
 
@@ -137,7 +144,8 @@ BenchCase multi_case(const Scenario& base, const AuditResult& null_r, int count,
   for (int k = 0; k < count; ++k) {
     const auto& cand = *pool[static_cast<std::size_t>(k)];
     double v = (2.0 + u(g)) * cand.threshold * (u(g) < 0.5 ? -1.0 : 1.0);
-    if (cand.effect == Effect::drive_feedthrough) v = std::abs(v);
+    if (cand.effect == Effect::drive_feedthrough || cand.effect == Effect::gap_harmonics)
+      v = std::abs(v);
     c.truths.push_back(static_cast<int>(cand.effect));
     c.true_values.push_back(v);
     conceal(s, cand.effect, v, g);
@@ -317,7 +325,8 @@ void run_single(const Scenario& base, const CandidateScore& cand, int d, std::mt
   c.strength = 0.3 + 2.7 * u(g);
   const double sign = u(g) < 0.5 ? -1.0 : 1.0;
   c.true_value = sign * c.strength * cand.threshold;
-  if (cand.effect == Effect::drive_feedthrough) c.true_value = std::abs(c.true_value);
+  if (cand.effect == Effect::drive_feedthrough || cand.effect == Effect::gap_harmonics)
+    c.true_value = std::abs(c.true_value);
   // Keep the damping physical: it may change by at most half over the
   // campaign's amplitude or temperature range. A design whose threshold
   // lies beyond that cannot reveal the effect and is not scored.
@@ -484,8 +493,9 @@ namespace {
 std::string format_confusion(const BenchResult& r) {
   std::string o;
   char buf[128];
-  static const char* kShort[kEffectCount + 1] = {"gain",   "phase",  "misal",  "duff",   "nldamp",
-                                                 "thfreq", "thdamp", "spring", "feedth", "none"};
+  static const char* kShort[kEffectCount + 1] = {"gain",   "phase",  "misal",  "duff",
+                                                 "nldamp", "thfreq", "thdamp", "spring",
+                                                 "feedth", "gap",    "none"};
   o += "Confusion matrix (rows: concealed effect, columns: top finding)\n";
   o += std::string(26, ' ');
   for (const char* s : kShort) {
@@ -536,6 +546,24 @@ std::string format_rates(const BenchResult& r) {
     if (nulls == 0) continue;
     std::snprintf(buf, sizeof buf, "  %-20s hits above 2x %d/%d, nulls with a finding %d/%d\n",
                   bench::design_name(kind), hits, above, null_found, nulls);
+    o += buf;
+  }
+  o += "By effect (one effect above 2x; pairs and triples that hold it, all found):\n";
+  for (const auto& info : effect_table()) {
+    const int e = static_cast<int>(info.effect);
+    int hits = 0, above = 0, multi = 0, multi_found = 0;
+    for (const auto& c : r.cases) {
+      if (c.kind == CaseKind::single && c.truth == e && c.strength >= 2.0) {
+        ++above;
+        if (is_hit(c)) ++hits;
+      } else if ((c.kind == CaseKind::pair || c.kind == CaseKind::triple) &&
+                 std::find(c.truths.begin(), c.truths.end(), e) != c.truths.end()) {
+        ++multi;
+        if (c.all_found) ++multi_found;
+      }
+    }
+    std::snprintf(buf, sizeof buf, "  %-24s hits above 2x %d/%d, with others %d/%d\n", info.id,
+                  hits, above, multi_found, multi);
     o += buf;
   }
   return o;

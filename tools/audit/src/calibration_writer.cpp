@@ -83,6 +83,10 @@ void apply_finding(fw::CalibrationFile& out, const Finding& f, const AuditResult
       set(out, "electrostatic_spring_hz_per_v2", f.value, f.sigma, 1.0);
       break;
     case Effect::drive_feedthrough: set_feedthrough(out, f, opt.pump_phase_rad, comments); break;
+    case Effect::gap_harmonics:
+      set(out, "gap_eps_p", f.gap_eps_pq_sigma[0], f.gap_eps_pq_sigma[2], 1.0);
+      set(out, "gap_eps_q", f.gap_eps_pq_sigma[1], f.gap_eps_pq_sigma[3], 1.0);
+      break;
   }
 }
 
@@ -109,9 +113,6 @@ CalibrationFromAudit calibration_from_audit(const AuditResult& r, const std::str
   if (r.verdict == "ambiguous" && !r.ambiguity_experiment.empty()) {
     c.push_back("ambiguous: " + r.ambiguity_experiment);
   }
-  c.push_back(
-      "not examined: ring-electrode gap harmonics (the seed's centring tolerance) are not in "
-      "the audit's model, so nothing here corrects them");
   c.push_back(
       "not in the file: the baseline (frequency, damping and its anisotropy, split, "
       "angular gain) is what the estimator identifies online, not a calibration");

@@ -237,29 +237,36 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.first_row = q0;
   f.last_row = q1;
   const std::size_t k = 3;
-  double ts = 0, te = 0, ps = 0, pe = 0;
+  double ts = 0, te = 0, ps = 0, pe = 0, ls = 0, le = 0;
   for (std::size_t j = 0; j < k; ++j) {
     ts += r.t[q0 + j] / k, ps += r.phase[q0 + j] / k;
     te += r.t[q1 - j] / k, pe += r.phase[q1 - j] / k;
+    ls += 0.5 * std::log(std::max(r.a2[q0 + j], 1e-30)) / k;
+    le += 0.5 * std::log(std::max(r.a2[q1 - j], 1e-30)) / k;
   }
   f.t0_s = ts;
   f.t1_s = te;
   f.freq_rad_s = (pe - ps) / (te - ts);
-  double c4 = 0, s4 = 0, v2 = 0, aa = 0, tc = 0, rr = 0;
+  double c4 = 0, s4 = 0, v2 = 0, v2c4 = 0, v2s4 = 0, aa = 0, tc = 0, rr = 0;
   for (std::size_t i = q0; i <= q1; ++i) {
-    c4 += std::cos(4.0 * r.theta[i]);
-    s4 += std::sin(4.0 * r.theta[i]);
-    v2 += r.pump ? (*r.pump)[i] * (*r.pump)[i] : 0.0;
+    const double ci = std::cos(4.0 * r.theta[i]), si = std::sin(4.0 * r.theta[i]);
+    const double vi = r.pump ? (*r.pump)[i] * (*r.pump)[i] : 0.0;
+    c4 += ci, s4 += si, v2 += vi, v2c4 += vi * ci, v2s4 += vi * si;
     aa += r.a2[i];
     tc += r.temp ? (*r.temp)[i] : 0.0;
     rr += r.rate_rad_s(i);
   }
   const auto m = static_cast<double>(best_len);
   f.mean_c4 = c4 / m, f.mean_s4 = s4 / m, f.mean_v2 = v2 / m, f.mean_a2 = aa / m;
+  f.mean_v2c4 = v2c4 / m, f.mean_v2s4 = v2s4 / m;
+  f.dlna_per_s = (le - ls) / (te - ts);
   f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
   f.theta0_rad = r.theta[q0];
   f.theta1_rad = r.theta[q1];
   f.se_rad_s = std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
+  f.balance_se_per_s = f.se_rad_s;  // ln a_A and the phase see the same noise per row
+  // theta from single rows: half the phase's noise per row (theta = arg / 2), k = 1.
+  f.angle_se_rad_s = f.se_rad_s * std::sqrt(static_cast<double>(k)) / 2.0;
   d.forced.push_back(f);
 }
 

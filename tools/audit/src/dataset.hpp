@@ -44,8 +44,14 @@ struct ForcedSegment {
   double sigma_rad_s = 0.0;             // weight in the fit: se and the scatter the model leaves
   double mean_c4 = 0.0, mean_s4 = 0.0;  // mean cos/sin 4 theta
   double theta0_rad = 0.0, theta1_rad = 0.0;
-  double mean_v2 = 0.0;  // mean pump_v^2
-  double mean_a2 = 0.0;  // mean a_A^2
+  double mean_v2 = 0.0;                     // mean pump_v^2
+  double mean_v2c4 = 0.0, mean_v2s4 = 0.0;  // mean pump_v^2 cos/sin 4 theta
+  double dlna_per_s = 0.0;  // (ln a_A(end) - ln a_A(start)) / (t1 - t0), ends as for the phase
+  double balance_se_per_s = 0.0;     // of dlna_per_s, from the white noise
+  double balance_sigma_per_s = 0.0;  // weight of the amplitude balance (0: not used)
+  double angle_se_rad_s = 0.0;       // of (theta1 - theta0)/(t1 - t0), from the white noise
+  double angle_sigma_rad_s = 0.0;    // weight of the pattern-angle drift (0: not used)
+  double mean_a2 = 0.0;              // mean a_A^2
   double mean_temp_c = 0.0;
   double mean_rate_rad_s = 0.0;
 };
@@ -60,8 +66,8 @@ struct Edge {
   // jump's (a direction taken from the jump's own rows bends the jump's noise
   // towards it and biases the sign-free statistic).
   std::vector<std::size_t> slope_rows;
-  double pump_v = 0.0;                 // mean |pump_v| over forced_rows (1 without the column)
-  std::vector<double> forced_pump_v;   // |pump_v| of each forced row (empty without the column)
+  double pump_v = 0.0;                // mean |pump_v| over forced_rows (1 without the column)
+  std::vector<double> forced_pump_v;  // |pump_v| of each forced row (empty without the column)
 };
 
 struct Dataset {

@@ -47,6 +47,14 @@ constexpr std::array<EffectInfo, kEffectCount> kTable{{
      "at every switching of the excitation, which no mechanical state can do.",
      "switch the pump at two voltages and look at the step of the demodulated signals at the "
      "switching instant"},
+    {Effect::gap_harmonics, "gap_harmonics", "eps", "-",
+     "The ring electrode's gap is not uniform (a 4th harmonic eps_p, eps_q of 1/d0^3, the "
+     "centring tolerance), so the pump drives the wave harder at some pattern angles: the "
+     "pump voltage the amplitude control needs follows 4 theta beyond what the damping "
+     "anisotropy asks, and the pump drifts the pattern while it runs.",
+     "hold the amplitude with the pump at several parked angles and compare the pump "
+     "voltage with the free-decay damping at the same angles: a damping anisotropy shows in "
+     "both, the gap only while the pump runs"},
 }};
 
 }  // namespace

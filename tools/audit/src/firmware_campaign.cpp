@@ -43,6 +43,8 @@ sim_run::RunConfig firmware_job(const Scenario& s) {
   sim::SimConfig& c = j.sim;
   c.resonator = s.resonator;
   c.electrodes.pump_gain_per_s2_v2 = s.electrodes.pump_gain_per_s2_v2;
+  c.electrodes.eps_p = s.electrodes.eps_p;
+  c.electrodes.eps_q = s.electrodes.eps_q;
   c.effects = s.effects;
   c.seed = s.seed;
   // White ADC noise that gives the scenario's noise per demodulated signal

@@ -157,8 +157,8 @@ double measured_phase(const Params& p, double theta) {
 double param_scale(int p) {
   static constexpr double kScale[kParamCount] = {
       1e-3, 1e-3, 1e-4, 1e-4, 1e-4, 1e-4, 1e-3, 1e-3, 1e-3, 1e-3, 1e-4, 1e-3,
-      1e-1, 1e-3, 1e-6, 1e-1, 1e-4, 1e-3, 1e-1, 1e-3, 1e-4, 1e-2, 1e-3, 1e-3,
-      1e-5, 1e-5, 1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5, 1e-5, 1e-4};
+      1e-1, 1e-3, 1e-6, 1e-2, 1e-2, 1e-1, 1e-4, 1e-3, 1e-1, 1e-3, 1e-4, 1e-2,
+      1e-3, 1e-3, 1e-5, 1e-5, 1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5, 1e-5, 1e-4};
   return kScale[p];
 }
 
@@ -185,10 +185,12 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
   for (const auto& f : d.forced) {
     const double dT = f.mean_temp_c - d.temp_ref_c;
     const double okf = f.mean_rate_rad_s * p[kK];
-    double w = p[kDw0] + p[kCor] * okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
-               p[kDwS] * f.mean_s4 + 2.0 * kPi * p[kDuff] * f.mean_a2 +
-               2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT + 2.0 * kPi * p[kEs] * f.mean_v2 +
-               2.0 * kPi * p[kGFreqExc];
+    double w =
+        p[kDw0] + p[kCor] * okf * okf / (4.0 * kPi * d.f_ref_hz) + p[kDwC] * f.mean_c4 +
+        p[kDwS] * f.mean_s4 + 2.0 * kPi * p[kDuff] * f.mean_a2 +
+        2.0 * kPi * d.f_ref_hz * 1e-6 * p[kTf] * dT +
+        2.0 * kPi * p[kEs] * (f.mean_v2 + 0.5 * (p[kGapP] * f.mean_v2c4 + p[kGapQ] * f.mean_v2s4)) +
+        2.0 * kPi * p[kGFreqExc];
     if (any_of(p, {kGFreqA4, kGFreqT2, kGFreqTime, kGFreq8C, kGFreq8S})) {
       double dw = 0.0, sg = 1.0;
       generic_terms(p, d,
@@ -201,6 +203,89 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
     dm = std::remainder(dm, kPi);
     w += dm / (f.t1_s - f.t0_s);
     r.push_back(f.freq_rad_s - w);
+  }
+  return r;
+}
+
+namespace {
+// Pattern angle and amplitude the pickoff map shows for a standing wave of
+// unit amplitude at theta.
+dsp::WaveVariables<double> measured_wave(const Params& p, double theta) {
+  const Mat2 c = pickoff(p);
+  const cplx x = c[0] * std::cos(2.0 * theta) + c[1] * std::sin(2.0 * theta);
+  const cplx y = c[2] * std::cos(2.0 * theta) + c[3] * std::sin(2.0 * theta);
+  return dsp::wave_variables<double>({x.real(), -x.imag(), y.real(), -y.imag()});
+}
+double measured_theta(const Params& p, double theta) {
+  return theta + std::remainder(measured_wave(p, theta).theta_A_rad - theta, kPi / 2.0);
+}
+}  // namespace
+
+std::vector<double> balance_left(const Dataset& d, const Params& p) {
+  std::vector<double> left;
+  left.reserve(d.forced.size());
+  for (const auto& f : d.forced) {
+    const double dT = f.mean_temp_c - d.temp_ref_c;
+    const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
+    // The amplitude the pickoffs show changes with the angle by itself.
+    const double readout =
+        std::log(measured_wave(p, f.theta1_rad).a_A_v / measured_wave(p, f.theta0_rad).a_A_v);
+    left.push_back(f.dlna_per_s - readout / (f.t1_s - f.t0_s) +
+                   s * (p[kNu] + p[kDnuC] * f.mean_c4 + p[kDnuS] * f.mean_s4));
+  }
+  return left;
+}
+
+namespace {
+// Mean of V^2 (1 + eps_p/2 c4 + eps_q/2 s4) over segment f: the pump's drive.
+double pump_drive_v2(const ForcedSegment& f, const Params& p) {
+  return f.mean_v2 + 0.5 * (p[kGapP] * f.mean_v2c4 + p[kGapQ] * f.mean_v2s4);
+}
+}  // namespace
+
+PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left) {
+  // Weighted least squares of left = (c0 + c1 dlna) M over the segments.
+  double n00 = 0.0, n01 = 0.0, n11 = 0.0, r0 = 0.0, r1 = 0.0;
+  for (std::size_t i = 0; i < d.forced.size(); ++i) {
+    const ForcedSegment& f = d.forced[i];
+    if (!(f.balance_sigma_per_s > 0.0)) continue;
+    const double w = 1.0 / (f.balance_sigma_per_s * f.balance_sigma_per_s);
+    const double m = pump_drive_v2(f, p), u = f.dlna_per_s * m;
+    n00 += w * m * m, n01 += w * m * u, n11 += w * u * u;
+    r0 += w * left[i] * m, r1 += w * left[i] * u;
+  }
+  const double det = n00 * n11 - n01 * n01;
+  if (!(det > 1e-12 * n00 * n11)) return {n00 > 0.0 ? r0 / n00 : 0.0, 0.0};
+  return {(n11 * r0 - n01 * r1) / det, (n00 * r1 - n01 * r0) / det};
+}
+
+std::vector<double> balance_residuals(const Dataset& d, const Params& p) {
+  std::vector<double> r;
+  const std::vector<double> left = balance_left(d, p);
+  const PumpGain c = balance_pump_gain(d, p, left);
+  for (std::size_t i = 0; i < d.forced.size(); ++i) {
+    const ForcedSegment& f = d.forced[i];
+    if (f.balance_sigma_per_s > 0.0) r.push_back(left[i] - c.at(f) * pump_drive_v2(f, p));
+  }
+  return r;
+}
+
+std::vector<double> angle_residuals(const Dataset& d, const Params& p) {
+  std::vector<double> r;
+  const std::vector<double> left = balance_left(d, p);
+  const PumpGain gain = balance_pump_gain(d, p, left);
+  for (const auto& f : d.forced) {
+    if (!(f.angle_sigma_rad_s > 0.0)) continue;
+    const double c = gain.at(f);
+    const double dT = f.mean_temp_c - d.temp_ref_c;
+    const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
+    const double drift = s * (p[kDnuC] * f.mean_s4 - p[kDnuS] * f.mean_c4) +
+                         0.5 * c * (p[kGapQ] * f.mean_v2c4 - p[kGapP] * f.mean_v2s4);
+    const double t = f.t1_s - f.t0_s;
+    const double readout = (measured_theta(p, f.theta1_rad) - f.theta1_rad) -
+                           (measured_theta(p, f.theta0_rad) - f.theta0_rad);
+    r.push_back((f.theta1_rad - f.theta0_rad - readout) / t -
+                0.5 * (drift - p[kK] * f.mean_rate_rad_s));
   }
   return r;
 }
@@ -239,6 +324,14 @@ void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vect
     const auto fr = forced_residuals(d, p);
     for (std::size_t i = 0; i < fr.size(); ++i)
       res.push_back(fr[i] / d.forced[i].sigma_rad_s);
+    const auto br = balance_residuals(d, p);
+    std::size_t k = 0;
+    for (const auto& f : d.forced)
+      if (f.balance_sigma_per_s > 0.0) res.push_back(br[k++] / f.balance_sigma_per_s);
+    const auto ar = angle_residuals(d, p);
+    k = 0;
+    for (const auto& f : d.forced)
+      if (f.angle_sigma_rad_s > 0.0) res.push_back(ar[k++] / f.angle_sigma_rad_s);
   }
 }
 

@@ -34,6 +34,8 @@ enum Param : int {
   kTf,     // thermal_frequency, ppm/degC
   kTd,     // thermal_damping, 1/degC
   kEs,     // electrostatic_spring, Hz/V^2
+  kGapP,   // gap_harmonics eps_p: 1/d0^3 ~ 1 + eps_p cos4th + eps_q sin4th (instrument axes)
+  kGapQ,   // gap_harmonics eps_q
   kCor,    // factor on the second-order Coriolis shift (Omega K)^2/2w: 1 for eq. 1;
            // fitted as a nuisance because first-order averaged simulators leave it out
   // Generic terms of the description of what the catalogue cannot name
@@ -73,13 +75,42 @@ struct EvalOptions {
 };
 
 // Residual vector in units of the noise: 4 per block (re/im of x, y) scaled
-// by sqrt(n)/noise, then one per excitation segment (frequency / sigma_rad_s).
+// by sqrt(n)/noise, then one per excitation segment (frequency / sigma_rad_s),
+// then one per excitation segment with a balance weight (balance / its sigma).
 // `pred`, when given, receives the predicted measured block means (x, y).
 void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vector<double>& res,
               std::vector<std::array<cplx, 2>>* pred = nullptr);
 
 // Frequency residuals (rad/s) of the excitation segments alone.
 std::vector<double> forced_residuals(const Dataset& d, const Params& p);
+
+// Amplitude balance of the excitation segments (1/s): the AGC holds a_A, so
+//   ln a_A(t1) - ln a_A(t0) + int s (nu + dnu_C c4 + dnu_S s4) dt
+//     = c int V^2 (1 + eps_p/2 c4 + eps_q/2 s4) dt
+// (the ring pump's in-phase force through the gap pattern G, seed eqs. 25-27;
+// s the damping scale of the thermal and nonlinear terms), per unit time. The
+// pump gain c is a nuisance, solved by weighted least squares inside every
+// evaluation (with its change while the loop recovers, PumpGain). Empty
+// unless the segments have their balance weights.
+std::vector<double> balance_residuals(const Dataset& d, const Params& p);
+// The left side of the balance per segment (1/s) and the pump gain of the
+// weighted fit (1/(s V^2)): c = c0 + c1 a_A'/a_A, the pump's efficiency
+// while the amplitude loop recovers from a window (its phase settling) is
+// not the one while it holds.
+std::vector<double> balance_left(const Dataset& d, const Params& p);
+struct PumpGain {
+  double c0 = 0.0, c1 = 0.0;
+  double at(const ForcedSegment& f) const { return c0 + c1 * f.dlna_per_s; }
+};
+PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left);
+
+// Pattern-angle drift of the same segments (rad/s): measured
+// (theta1 - theta0)/(t1 - t0) against Omega K = -2 theta' + D (physics.md) with
+//   D = s (dnu_C sin4th - dnu_S cos4th) + c V^2 (eps_q/2 cos4th - eps_p/2 sin4th)
+// (the damping anisotropy's drift and the pump's through the gap, c from the
+// balance) and the pickoff map's readout distortion at both ends. One per
+// segment with an angle weight.
+std::vector<double> angle_residuals(const Dataset& d, const Params& p);
 
 // exp(A t) of a 2x2 complex matrix (closed form).
 using Mat2 = std::array<cplx, 4>;  // row-major

@@ -76,6 +76,12 @@ std::string impact_text(const Dataset& d_, const Params& p, Effect e, double v) 
           "up to %.3g deg while the excitation is on",
           v * std::sqrt(v2), v * std::sqrt(v2) / std::sqrt(std::max(a2, 1e-30)) * kRadToDeg / 2.0);
       break;
+    case Effect::gap_harmonics:
+      // D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th), kappa ~ nu with the AGC holding a_A.
+      std::snprintf(buf, sizeof buf,
+                    "pump drift D_Phi up to %.3g deg/h (4-theta pattern) while the pump runs",
+                    p[kNu] * v / 2.0 / k * kRadToDeg * 3600.0);
+      break;
   }
   return buf;
 }
@@ -163,6 +169,13 @@ void add_candidate_locations(const Dataset& d_, AuditResult& out) {
         break;
       case Effect::drive_feedthrough:
         signal = "cx_v,sx_v,cy_v,sy_v", where = "steps at the switch-offs of exc";
+        break;
+      case Effect::gap_harmonics:
+        std::snprintf(buf, sizeof buf,
+                      "4-theta pattern of the pump the amplitude control needs, pump_v^2 "
+                      "%.3g-%.3g V^2",
+                      v_lo, v_hi);
+        signal = "pump_v", where = buf;
         break;
     }
     const bool dup = std::any_of(out.locations.begin(), out.locations.end(),

@@ -41,6 +41,10 @@ struct Calibration {
   double duffing_hz_per_v2 = 0.0;               // frequency + c a^2 (Hz/V^2 of pickoff)
   double electrostatic_spring_hz_per_v2 = 0.0;  // frequency + c V_pump^2 while on (Hz/V^2)
   double nonlinear_damping_per_v2 = 0.0;  // damping x (1 + eta E), E in V^2 of pickoff (1/V^2)
+  // Ring electrode gap: 1/d0^3 ~ 1 + eps_p cos4theta + eps_q sin4theta (instrument
+  // axes, seed eqs. 25-29). Gives the pump's drift D_Phi (est::known_gap_drift_rad_s).
+  double gap_eps_p = 0.0;  // eps_p (-)
+  double gap_eps_q = 0.0;  // eps_q (-)
 };
 
 // One field: its key (unit in the name), its physical range, where it lives.
@@ -51,7 +55,7 @@ struct CalibrationField {
   double Calibration::*member;
 };
 
-inline constexpr std::size_t kCalibrationFieldCount = 13;
+inline constexpr std::size_t kCalibrationFieldCount = 15;
 inline constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 // Physical ranges: wide enough for any gyro the chain can run (a 20 % gain
@@ -73,6 +77,8 @@ inline constexpr std::array<CalibrationField, kCalibrationFieldCount> kCalibrati
     {"duffing_hz_per_v2", -1.0, 1.0, &Calibration::duffing_hz_per_v2},
     {"electrostatic_spring_hz_per_v2", -0.1, 0.1, &Calibration::electrostatic_spring_hz_per_v2},
     {"nonlinear_damping_per_v2", -1.0, 10.0, &Calibration::nonlinear_damping_per_v2},
+    {"gap_eps_p", -0.2, 0.2, &Calibration::gap_eps_p},
+    {"gap_eps_q", -0.2, 0.2, &Calibration::gap_eps_q},
 }};
 
 // Index of the first field outside its range (NaN included), or -1 when all are in range.
@@ -89,7 +95,7 @@ constexpr int first_out_of_range(const Calibration& c) {
 inline constexpr Calibration kIdentityCalibration{};
 static_assert(first_out_of_range(kIdentityCalibration) < 0);
 
-// Canonical serialisation: version byte + 13 x binary64 LE = 105 bytes.
+// Canonical serialisation: version byte + 15 x binary64 LE = 121 bytes.
 inline constexpr uint8_t kCalibrationFormatVersion = 1;
 inline constexpr std::size_t kCalibrationBytes = 1 + 8 * kCalibrationFieldCount;
 using CalibrationBytes = std::array<uint8_t, kCalibrationBytes>;

@@ -24,8 +24,9 @@ enum class Effect {
   thermal_damping,
   electrostatic_spring,
   drive_feedthrough,
+  gap_harmonics,
 };
-inline constexpr int kEffectCount = 9;
+inline constexpr int kEffectCount = 10;
 
 struct EffectInfo {
   Effect effect;
@@ -94,6 +95,9 @@ struct Finding {
   // drive_feedthrough only: c_x and c_y as re/im pairs (V/V) against the wave
   // phase at the edge (the recording carries the pump amplitude, not its phase).
   std::array<double, 4> feedthrough_re_im{};
+  // gap_harmonics only (value is |eps| = hypot(eps_p, eps_q)): eps_p, eps_q
+  // and their 1-sigma.
+  std::array<double, 4> gap_eps_pq_sigma{};
 };
 
 // One term of the generic description of structure no catalogue effect names.
