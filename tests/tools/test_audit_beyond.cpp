@@ -138,3 +138,40 @@ TEST(AuditBeyondCatalogue, ReferenceFollowingTheResonanceIsRead) {
   CHECK(r.findings.front().effect == Effect::pickoff_phase_mismatch);
   DOUBLES_EQUAL(phase, r.findings.front().value, 0.2 * std::abs(phase));
 }
+
+TEST(AuditBeyondCatalogue, ThermalEffectAndDriftInTimeAreToldApartOrNotNamed) {
+  // GIVEN a ring-down campaign with a thermal damping at 4x the null twin's
+  // threshold, its temperature on a sine swing of 1.3 recording lengths
+  const bench::Scenario base = ringdown();
+  const AuditResult null = hrg::audit::run_audit(bench::simulate(base));
+  const double td = 4.0 * threshold_of(null, Effect::thermal_damping);
+  bench::Scenario s = base;
+  CHECK(bench::conceal_by_id(s, "thermal_damping", td, kSeed));
+  hrg::recording::Recording rec = bench::simulate(s);
+  const AuditResult r = hrg::audit::run_audit(rec);
+  // THEN the damping follows the temperature, not time: a finding
+  const auto* f = finding_of(r, Effect::thermal_damping);
+  CHECK_TEXT(f != nullptr, hrg::audit::to_text(r, "thermal damping").c_str());
+  DOUBLES_EQUAL(td, f->value, 0.2 * td);
+  // WHEN the temperature column of the same recording is a straight line in
+  // time over the same range (a reading that follows time): a damping linear
+  // in it and a damping drifting in time are then the same model
+  auto& temp = rec.column("temp_c");
+  const auto& t = rec.column("t_s");
+  const auto [lo, hi] = std::minmax_element(temp.begin(), temp.end());
+  const double t_lo = *lo, span_c = *hi - *lo;
+  for (std::size_t i = 0; i < temp.size(); ++i)
+    temp[i] = t_lo + span_c * (t[i] - t.front()) / (t.back() - t.front());
+  const AuditResult c = hrg::audit::run_audit(rec);
+  const std::string text = hrg::audit::to_text(c, "temperature follows time");
+  // THEN the thermal damping is no finding but an alternative saying why,
+  // and the verdict is ambiguous with the experiment that separates them
+  CHECK_TEXT(finding_of(c, Effect::thermal_damping) == nullptr, text.c_str());
+  const auto alt = std::find_if(c.alternatives.begin(), c.alternatives.end(), [](const auto& a) {
+    return a.effect == Effect::thermal_damping &&
+           a.note.find("temperature follows time") != std::string::npos;
+  });
+  CHECK_TEXT(alt != c.alternatives.end(), text.c_str());
+  CHECK_TEXT(c.verdict == "ambiguous" || c.verdict == "unexplained", text.c_str());
+  CHECK(c.ambiguity_experiment.find("independently of time") != std::string::npos);
+}

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <numbers>
 #include <stdexcept>
+#include <string_view>
 
 #include <Eigen/Dense>
 
@@ -51,6 +52,7 @@ constexpr std::size_t kBalanceMinSegments = 10;
 // wave rings up with the pump saturated, never used.
 constexpr double kBalanceHeld = 0.05;
 constexpr double kBalanceHold = 0.5;
+constexpr const char* kSomeEvidence = "some evidence, below the acceptance level";
 
 // Model parameter of each effect (-1: the edge statistic instead); the gap
 // harmonics have a second one (second_param_of).
@@ -109,6 +111,13 @@ Mask with_term(Mask m, const GenericTerm& t) {
   for (int i : t.params())
     m[static_cast<std::size_t>(i)] = true;
   return m;
+}
+
+// The generic term with this id (nullptr: none).
+const GenericTerm* term_of(std::string_view id) {
+  for (const auto& g : generic_terms())
+    if (std::string_view(g.id) == id) return &g;
+  return nullptr;
 }
 
 // Effects taken by the forward selection, in the order they were taken.
@@ -174,13 +183,15 @@ class Auditor {
   std::vector<Candidate> score_candidates(const State& cur, const std::vector<Chosen>& chosen,
                                           bool first_step, AuditResult& out);
   void retest_runner_up(const std::vector<Candidate>& cands, AuditResult& out);
-  std::vector<Chosen> forward_select(State& cur, AuditResult& out);
+  void forward_select(State& cur, std::vector<Chosen>& chosen, AuditResult& out);
   void test_feedthrough(const State& cur, const FeedStat& ft, std::vector<Chosen>& chosen,
                         AuditResult& out);
   State describe(const State& cat, AuditResult& out);
   void finish_description(const State& cur, double heldout_after, AuditResult& out);
   State drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out);
   State test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out);
+  void test_thermal_vs_drift(const State& full, std::vector<Chosen>& chosen, AuditResult& out);
+  double temp_time_correlation() const;
   void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                       bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
@@ -196,6 +207,7 @@ class Auditor {
   double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
   Params start_balance_{};  // the free-decay baseline the balance starts from
+  bool confounded_ = false;  // a thermal effect and a drift in time cannot be told apart
 };
 
 bool Auditor::testable(Effect e) const {
@@ -590,19 +602,22 @@ void Auditor::retest_runner_up(const std::vector<Candidate>& cands, AuditResult&
                              ": " + effect_info(win.e).separating_experiment;
 }
 
-// Forward selection refitting everything at each step; `cur` ends as the
-// selected model.
-std::vector<Chosen> Auditor::forward_select(State& cur, AuditResult& out) {
-  std::vector<Chosen> chosen;
-  bool first_step = true;
-  while (chosen.size() < 4) {
+// Forward selection refitting everything at each step, from the effects
+// already `chosen` on; `cur` ends as the selected model. Up to four catalogue
+// effects besides drive feedthrough (tested on the edges).
+void Auditor::forward_select(State& cur, std::vector<Chosen>& chosen, AuditResult& out) {
+  bool first_step = chosen.empty();
+  auto in_model = [&] {
+    return std::count_if(chosen.begin(), chosen.end(),
+                         [](const Chosen& c) { return c.effect != Effect::drive_feedthrough; });
+  };
+  while (in_model() < 4) {
     std::vector<Candidate> cands = score_candidates(cur, chosen, first_step, out);
     first_step = false;
     if (cands.empty() || cands[0].dbic < opt_.min_delta_bic) {
       for (const auto& c : cands) {
         if (c.dbic > 0.0) {
-          out.alternatives.push_back(
-              {c.e, c.value, c.dbic, "some evidence, below the acceptance level"});
+          out.alternatives.push_back({c.e, c.value, c.dbic, kSomeEvidence});
         }
       }
       break;
@@ -611,7 +626,6 @@ std::vector<Chosen> Auditor::forward_select(State& cur, AuditResult& out) {
     chosen.push_back({cands[0].e, cands[0].dbic, cur.fit.chi2 - cands[0].s.fit.chi2});
     cur = std::move(cands[0].s);
   }
-  return chosen;
 }
 
 // Drive feedthrough against the final model.
@@ -622,8 +636,8 @@ void Auditor::test_feedthrough(const State& cur, const FeedStat& ft, std::vector
   if (dbic >= opt_.min_delta_bic) {
     chosen.push_back({Effect::drive_feedthrough, dbic, ft.dchi2});
   } else if (dbic > 0.0) {
-    out.alternatives.push_back({Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic,
-                                "some evidence, below the acceptance level"});
+    out.alternatives.push_back(
+        {Effect::drive_feedthrough, std::max(ft.c_x, ft.c_y), dbic, kSomeEvidence});
   }
 }
 
@@ -741,9 +755,7 @@ State Auditor::test_constancy(State full, std::vector<Chosen>& chosen, AuditResu
     const auto it = std::find_if(chosen.begin(), chosen.end(),
                                  [&](const Chosen& c) { return c.effect == v.e; });
     if (it == chosen.end()) continue;
-    const GenericTerm* t = nullptr;
-    for (const auto& g : generic_terms())
-      if (std::string_view(g.id) == v.term) t = &g;
+    const GenericTerm* t = term_of(v.term);
     if (t == nullptr || full.mask[static_cast<std::size_t>(t->param_ids[0])]) continue;
     if (t->needs_temp && !(d_.has_temp && d_.temp_span_c > 0.02)) continue;
     State s = fit_state(with_term(full.mask, *t), full.fit.p, full.feedthrough);
@@ -774,6 +786,68 @@ State Auditor::test_constancy(State full, std::vector<Chosen>& chosen, AuditResu
   }
   if (changed) finish_description(full, heldout_rms(full.mask, full.fit.p), out);
   return full;
+}
+
+// Correlation of the temperature with time over the free-decay blocks.
+double Auditor::temp_time_correlation() const {
+  double n = 0.0, st = 0.0, sT = 0.0, stt = 0.0, sTT = 0.0, stT = 0.0;
+  for (const auto& s : d_.free) {
+    for (std::size_t b = 0; b < s.n_blocks; ++b) {
+      const Block& bl = d_.blocks[s.first_block + b];
+      n += 1.0, st += bl.t_s, sT += bl.temp_c;
+      stt += bl.t_s * bl.t_s, sTT += bl.temp_c * bl.temp_c, stT += bl.t_s * bl.temp_c;
+    }
+  }
+  const double vt = stt - st * st / n, vT = sTT - sT * sT / n;
+  return vt > 0.0 && vT > 0.0 ? (stT - st * sT / n) / std::sqrt(vt * vT) : 0.0;
+}
+
+// A thermal effect is linear in the temperature, a drift linear in time:
+// when the temperature follows time over the recording the two predict the
+// same, and the recording cannot say which it is (a slow change of the gyro,
+// or of its electronics, that is no thermal effect at all). Each accepted
+// thermal effect is refitted with the same quantity drifting in time in its
+// place (everything else kept); unless the thermal model fits better by the
+// acceptance level, it is no finding: an alternative with the reason, and
+// the verdict is ambiguous with the experiment that separates them.
+void Auditor::test_thermal_vs_drift(const State& full, std::vector<Chosen>& chosen,
+                                    AuditResult& out) {
+  static constexpr struct {
+    Effect e;
+    const char* term;
+    const char* quantity;
+  } kPairs[] = {{Effect::thermal_damping, "damping_drift", "damping"},
+                {Effect::thermal_frequency, "frequency_drift", "frequency"}};
+  for (const auto& pr : kPairs) {
+    const auto it = std::find_if(chosen.begin(), chosen.end(),
+                                 [&](const Chosen& c) { return c.effect == pr.e; });
+    const GenericTerm* t = term_of(pr.term);
+    if (it == chosen.end() || t == nullptr) continue;
+    const auto pc = static_cast<std::size_t>(param_of(pr.e));
+    const auto pt = static_cast<std::size_t>(t->param_ids[0]);
+    if (full.mask[pt]) continue;  // the drift is in the model already
+    Mask m = full.mask;
+    m[pc] = false, m[pt] = true;
+    Params q = full.fit.p;
+    q[pc] = 0.0;
+    const State swapped = fit_state(m, q, full.feedthrough);
+    const double margin = delta_chi2(swapped, full);
+    if (margin >= opt_.min_delta_bic) continue;
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "the temperature follows time in this recording (correlation %.3f over the free "
+                  "decays): a %s drift in time explains the same (thermal better by chi^2 %.1f "
+                  "only), so the two cannot be told apart",
+                  temp_time_correlation(), pr.quantity, margin);
+    out.alternatives.push_back({pr.e, to_catalogue(pr.e, full.fit.p[pc]), it->dbic, buf});
+    if (out.ambiguity_experiment.empty()) {
+      out.ambiguity_experiment = std::string(effect_info(pr.e).id) + " vs a " + pr.quantity +
+                                 " drift in time: repeat with the temperature swinging "
+                                 "independently of time (up and down over the run)";
+    }
+    confounded_ = true;
+    chosen.erase(it);
+  }
 }
 
 // Backward elimination over the chosen catalogue effects: each is refitted
@@ -910,7 +984,7 @@ void Auditor::set_verdict(const State& cur, const FeedStat& ft, bool structure_l
       out.unexplained_note += "; largest at " + left.front().signal + ", " + left.front().where;
     out.verdict = "unexplained";
   } else if (out.findings.empty()) {
-    out.verdict = "consistent";
+    out.verdict = confounded_ ? "ambiguous" : "consistent";
   } else if (!out.ambiguity_experiment.empty()) {
     out.verdict = "ambiguous";
   } else {
@@ -926,7 +1000,8 @@ AuditResult Auditor::run(PlotData* plot) {
   const State baseline = fit_baseline(out);
   describe_data(out);
   State cur = baseline;
-  std::vector<Chosen> chosen = forward_select(cur, out);
+  std::vector<Chosen> chosen;
+  forward_select(cur, chosen, out);
   // The switching edges against the final free-decay model.
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   test_feedthrough(cur, ft, chosen, out);
@@ -938,6 +1013,7 @@ AuditResult Auditor::run(PlotData* plot) {
   State full = describe(cur, out);
   full = drop_unneeded(std::move(full), chosen, out);
   full = test_constancy(std::move(full), chosen, out);
+  test_thermal_vs_drift(full, chosen, out);
   // Structure is left when the description found some, or when the residual
   // stays above the noise including its slow (coloured) part.
   const double ratio = full.fit.chi2 / std::max(1.0, static_cast<double>(full.fit.n_res));
