@@ -110,12 +110,12 @@ double quad_force_rate_v_s(double forcer_gain_per_s2, double w_rad_s, double u_q
 
 // Slow outputs, one set per block (control rate), SI units.
 struct ChainOutputs {
-  Quadratures<double> quad_v;   // cx, sx, cy, sy, volts of pickoff
-  WaveVariables<double> wave;   // E, Q, R, S (V^2), a_A, a_B (V), theta wrapped, phase
-  double theta_A_rad = 0.0;     // unwrapped pattern angle
-  double phase_err_rad = 0.0;   // PLL phase detector output (wave phase mod pi)
-  double pll_freq_hz = 0.0;     // NCO frequency for the next block
-  double pump_v = 0.0;          // pump amplitude V0 written for the next block
+  Quadratures<double> quad_v;  // cx, sx, cy, sy, volts of pickoff
+  WaveVariables<double> wave;  // E, Q, R, S (V^2), a_A, a_B (V), theta wrapped, phase
+  double theta_A_rad = 0.0;    // unwrapped pattern angle
+  double phase_err_rad = 0.0;  // PLL phase detector output (wave phase mod pi)
+  double pll_freq_hz = 0.0;    // NCO frequency for the next block
+  double pump_v = 0.0;         // pump amplitude V0 written for the next block
   // Amplitude of the pump envelope that this block's quadratures saw: the
   // decimator's weights over the blocks whose pump acted in its window (what
   // a drive feedthrough in them is proportional to), V.

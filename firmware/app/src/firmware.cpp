@@ -62,8 +62,7 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
   estimator_.set_known_gap(cal.gap_eps_p, cal.gap_eps_q);
   gyro_.restart_pump_edge_check();
   guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
-                 has_feedthrough(cal),
-                 gyro_.status().chain.t_s, estimator_.health(), checking());
+                 has_feedthrough(cal), gyro_.status().chain.t_s, estimator_.health(), checking());
   return true;
 }
 

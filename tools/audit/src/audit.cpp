@@ -206,7 +206,7 @@ class Auditor {
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
   double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
-  Params start_balance_{};  // the free-decay baseline the balance starts from
+  Params start_balance_{};   // the free-decay baseline the balance starts from
   bool confounded_ = false;  // a thermal effect and a drift in time cannot be told apart
 };
 
