@@ -133,8 +133,6 @@ bool judge(const RunConfig& job, RunResult& r) {
 
 namespace {
 
-// The calibration's trial: where it came from, the check window that judged
-// it (misfits over the fit's own residual), withdrawn or not.
 // The switch-off step check: the residual feedthrough it measures (V/V per
 // volt of pump, against the NCO) and the step at the last edge's pump.
 void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
@@ -152,6 +150,8 @@ void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
   w.end_object();
 }
 
+// The calibration's trial: where it came from, the check window that judged
+// it (misfits over the fit's own residual), withdrawn or not.
 void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
                       const fw::Calibration& in_force) {
   w.begin_object("calibration");
