@@ -77,12 +77,26 @@ run() {  # run NAME SEED_DIR SECONDS
   else
     echo "fuzz: $name FAILED"
     grep -E 'ERROR|SUMMARY|runtime error|deadly signal' "$out/$name.log" | head -n 20
-    fail=1
+    return 1
   fi
 }
-run fuzz_command_decoder "$out/seed-command" "$seconds"
-run fuzz_candump_reader "$out/seed-candump" "$seconds"
-run fuzz_dbc_parser "$out/seed-dbc" "$(( (seconds + 1) / 2 ))"
-run fuzz_recording_reader "$out/seed-recording" "$seconds"
-run fuzz_scenario_reader "$out/seed-scenario" "$seconds"
+# Each fuzzer is single-threaded: two at a time keep both cores of the CI
+# machine busy and halve the step. Each pair's lines print when it ends.
+pair() {  # pair "NAME SEEDS SECONDS" ["NAME SEEDS SECONDS"]
+  local pids=() logs=() i=0 spec
+  for spec in "$@"; do
+    # shellcheck disable=SC2086
+    ( run $spec ) >"$out/pair-$i.txt" &
+    pids+=($!); logs+=("$out/pair-$i.txt"); i=$((i + 1))
+  done
+  for i in "${!pids[@]}"; do
+    wait "${pids[$i]}" || fail=1
+    cat "${logs[$i]}"
+  done
+}
+pair "fuzz_command_decoder $out/seed-command $seconds" \
+  "fuzz_candump_reader $out/seed-candump $seconds"
+pair "fuzz_recording_reader $out/seed-recording $seconds" \
+  "fuzz_scenario_reader $out/seed-scenario $seconds"
+pair "fuzz_dbc_parser $out/seed-dbc $(( (seconds + 1) / 2 ))"
 exit $fail
