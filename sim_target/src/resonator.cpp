@@ -227,7 +227,7 @@ void Resonator::step(const Drive& drive, double dt_s) {
   const double energy =
       needs_energy ? u_(0) * u_(0) + u_(1) * u_(1) + (u_(2) * u_(2) + u_(3) * u_(3)) / (w * w)
                    : 0.0;
-  Vec4 next = propagate(drive);
+  Vec4 next = propagate(drive, u_);
 
   double c_iso = w * w - omega_c_ * omega_c_;
   if (effects_.duffing_stiffness.enabled) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "sim_target/averaged_model.hpp"
@@ -146,10 +147,12 @@ void SimTarget::fill_drives(std::size_t m) {
 
 void SimTarget::delay_frames(std::size_t m) {
   const std::size_t latency = dac_latency_.size();
+  std::size_t pos = latency_pos_;
   for (std::size_t k = 0; k < m; ++k) {
-    std::swap(frames_[k], dac_latency_[latency_pos_]);
-    if (++latency_pos_ == latency) latency_pos_ = 0;
+    std::swap(frames_[k], dac_latency_[pos]);
+    pos = pos + 1 == latency ? 0 : pos + 1;
   }
+  latency_pos_ = pos;
 }
 
 namespace {
@@ -182,6 +185,32 @@ void SimTarget::run_resonator(std::size_t n, double dt) {
     volts_[2 * k] = p.x_v + offset_x;
     volts_[2 * k + 1] = p.y_v + offset_y;
   });
+}
+
+bool SimTarget::plain_noise() const {
+  const auto& rms = config_.adc.noise_v_rms;
+  return (rms[0] != 0.0 || rms[1] != 0.0) && !(burst_left_s_ > 0.0);
+}
+
+void SimTarget::run_resonator_with_noise(std::size_t n, double dt) {
+  // run_resonator() and add_noise() in one loop, the same expressions and
+  // draws in the same order: the normals are drawn while the step's
+  // dependency chain runs.
+  const double offset_x = config_.adc.offset_v[0];
+  const double offset_y = config_.adc.offset_v[1];
+  const double rms_x = config_.adc.noise_v_rms[0];
+  const double rms_y = config_.adc.noise_v_rms[1];
+  double* volts = volts_.data();
+  detail::Gaussian::Stream noise(noise_);
+  resonator_.step_block(
+      drives_.data(), n, dt,
+      [volts, offset_x, offset_y, rms_x, rms_y, &noise](std::size_t k, const PickoffOutput& p) {
+        const double nx = noise.normal();
+        const double ny = noise.normal();
+        volts[2 * k] = (p.x_v + offset_x) + rms_x * nx;
+        volts[2 * k + 1] = (p.y_v + offset_y) + rms_y * ny;
+      });
+  noise.commit();
 }
 
 void SimTarget::add_noise(std::size_t n, double dt) {
@@ -240,11 +269,16 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
     fill_drives(m);
     last_pump_v_ = drives_[m - 1].pump_v;
     laps.lap(&SimStageTimes::dac_ns);
-    run_resonator(m, dt);
+    if (plain_noise() && !profiling_) {
+      run_resonator_with_noise(m, dt);
+      laps.lap(&SimStageTimes::resonator_ns);
+    } else {
+      run_resonator(m, dt);
+      laps.lap(&SimStageTimes::resonator_ns);
+      add_noise(m, dt);
+      laps.lap(&SimStageTimes::noise_ns);
+    }
     sample_index_ += m;
-    laps.lap(&SimStageTimes::resonator_ns);
-    add_noise(m, dt);
-    laps.lap(&SimStageTimes::noise_ns);
     clipped += quantize(m, frames.data() + 2 * done);
     laps.lap(&SimStageTimes::adc_ns);
   }
@@ -285,9 +319,11 @@ Status SimTarget::SimDac::write_block(std::span<const hal::q31_t> frames) {
   if (frames.size() != n * hal::kDacChannels) return Status::invalid_argument;
   if (t->dac_queue_.size() - t->dac_head_ >= 4 * n)
     return Status::would_block;  // four blocks ahead at most
-  for (std::size_t k = 0; k < n; ++k) {
-    t->dac_queue_.push_back({frames[3 * k], frames[3 * k + 1], frames[3 * k + 2]});
-  }
+  // Whole frames in one copy (a DacFrame is the block's three words).
+  static_assert(sizeof(DacFrame) == hal::kDacChannels * sizeof(hal::q31_t));
+  const std::size_t old = t->dac_queue_.size();
+  t->dac_queue_.resize(old + n);
+  std::memcpy(t->dac_queue_.data() + old, frames.data(), n * sizeof(DacFrame));
   t->dac_written_ = true;
   return Status::ok;
 }

@@ -75,6 +75,30 @@ TEST(Gaussian, MomentsTailsAndHistogramAreTheNormalOnes) {
   CHECK(chi2 < dof + 5.0 * std::sqrt(2.0 * dof));
 }
 
+TEST(Gaussian, StreamGivesTheSameDrawsAsNormalInTurn) {
+  // 1e5 draws (about 1200 wedges or tail draws, which go back through the
+  // generator), started with a refill's leftovers in the buffer and with
+  // normal() and fill() between the streams.
+  hrg::sim::detail::Gaussian a(11);
+  hrg::sim::detail::Gaussian b(11);
+  double block[300];
+  std::size_t drawn = 0;
+  for (int round = 0; round < 330; ++round) {
+    CHECK_EQUAL(b.normal(), a.normal());
+    a.fill(block, 17);
+    for (std::size_t i = 0; i < 17; ++i)
+      CHECK_EQUAL(b.normal(), block[i]);
+    hrg::sim::detail::Gaussian::Stream s(a);
+    for (std::size_t i = 0; i < 300; ++i)
+      block[i] = s.normal();
+    s.commit();
+    for (double v : block)
+      CHECK_EQUAL(b.normal(), v);
+    drawn += 318;
+  }
+  CHECK(drawn > 100'000);
+}
+
 TEST(Gaussian, FillGivesTheSameDrawsAsNormalInTurn) {
   hrg::sim::detail::Gaussian a(7);
   hrg::sim::detail::Gaussian b(7);

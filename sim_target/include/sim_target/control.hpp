@@ -146,6 +146,9 @@ class SimTarget {
   hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped);
   void run_resonator(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
+  // Noise on and no burst: the resonator and the noise may share one loop.
+  bool plain_noise() const;
+  void run_resonator_with_noise(std::size_t n, double dt);
   uint32_t quantize(std::size_t n, hal::q31_t* out);
   // One ADC conversion with the channel's faults; 1 when it clipped.
   uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {

@@ -36,6 +36,7 @@
 #include <array>
 #include <complex>
 #include <cstdint>
+#include <cstring>
 
 #include <Eigen/Dense>
 
@@ -105,14 +106,28 @@ class Resonator {
       return;
     }
     const HeldCoefficients c = prepare_held(rate, temp_c, dt_s);
+    if (c.iso == 0.0 && c.damp == 0.0 && !pickoff_effects_) {
+      step_plain(drives, n, sink);
+      cursor_steps_ = steps_ - 1;
+      return;
+    }
+    // The state stays in registers: the sink's stores could alias u_, and a
+    // store and reload per step would lengthen the step's dependency chain.
+    Vec4 u = u_;
     for (std::size_t k = 0; k < n; ++k) {
-      sink(k, measured());
-      Vec4 next = propagate(drives[k]);
-      if (c.iso != 0.0) next.noalias() += psi_iso_ * (c.iso * u_);
-      if (c.damp != 0.0) next.noalias() += psi_damp_ * (c.damp * u_);
-      u_ = next;
+      if (pickoff_effects_) {
+        u_ = u;
+        sink(k, measured_with_effects());
+      } else {
+        sink(k, PickoffOutput{u(0), u(1)});
+      }
+      Vec4 next = propagate(drives[k], u);
+      if (c.iso != 0.0) next.noalias() += psi_iso_ * (c.iso * u);
+      if (c.damp != 0.0) next.noalias() += psi_damp_ * (c.damp * u);
+      u = next;
       ++steps_;
     }
+    u_ = u;
     cursor_steps_ = steps_ - 1;
   }
 
@@ -145,17 +160,60 @@ class Resonator {
   void prepare_step(double rate_rad_s, double w, double dt_s);
   // The linear part of one step (propagator at the rate, forcers, pump
   // and spring), the <V^2> history advanced by the drive's pump voltage.
-  [[gnu::always_inline]] Vec4 propagate(const Drive& drive) {
+  [[gnu::always_inline]] Vec4 propagate(const Drive& drive, const Vec4& u) {
     // Pump history: <V^2> over one reference period (the DC part of V^2).
     const double v2_dc = push_pump(drive.pump_v);
     // [propagator u; pump sensitivity u] in one 8x4 product.
-    const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u_;
+    const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u;
     Vec4 next = terms.head<4>();
     next.noalias() += gamma_ * Eigen::Vector2d(drive.forcer_x_v, drive.forcer_y_v);
     const double v2 = drive.pump_v * drive.pump_v;
     const double c_gap = electrodes_.pump_gain_per_s2_v2 * (v2 - v2_dc) + spring_k_ * v2_dc;
     next += c_gap * terms.tail<4>();
     return next;
+  }
+  // step_block's held-inputs loop when no stiffness, damping or pickoff term
+  // is on: propagate() written out on pairs of rows, the same operations in
+  // the same order (Eigen's sums column by column: ((c0 u0 + c1 u1) + c2 u2)
+  // + c3 u3, then the forcers, then the pump and spring term), so the same
+  // bits, with the state in registers from one step to the next.
+  template <class Sink>
+  [[gnu::always_inline]] void step_plain(const Drive* drives, std::size_t n, Sink& sink) {
+    using v2d = double __attribute__((vector_size(16)));
+    const auto pair = [](const double* p) {
+      v2d v;
+      std::memcpy(&v, p, sizeof v);
+      return v;
+    };
+    const auto splat = [](double x) { return v2d{x, x}; };
+    const double* r = rate_gap_.data();  // 8x4, column-major
+    const double* g = gamma_.data();     // 4x2, column-major
+    const double k_pump = electrodes_.pump_gain_per_s2_v2;
+    const double k_spring = spring_k_;
+    v2d pos = {u_(0), u_(1)};  // x, y
+    v2d vel = {u_(2), u_(3)};  // x', y'
+    for (std::size_t k = 0; k < n; ++k) {
+      sink(k, PickoffOutput{pos[0], pos[1]});
+      const Drive d = drives[k];
+      const double v2_dc = push_pump(d.pump_v);
+      const double v2 = d.pump_v * d.pump_v;
+      const v2d c_gap = splat(k_pump * (v2 - v2_dc) + k_spring * v2_dc);
+      const v2d u0 = splat(pos[0]);
+      const v2d u1 = splat(pos[1]);
+      const v2d u2 = splat(vel[0]);
+      const v2d u3 = splat(vel[1]);
+      // Rows (i, i + 1) of [Phi_rate; Psi_gap] u, column by column.
+      const auto rows = [&](std::size_t i) {
+        return ((pair(r + i) * u0 + pair(r + 8 + i) * u1) + pair(r + 16 + i) * u2) +
+               pair(r + 24 + i) * u3;
+      };
+      const v2d fx = splat(d.forcer_x_v);
+      const v2d fy = splat(d.forcer_y_v);
+      pos = (rows(0) + (pair(g) * fx + pair(g + 4) * fy)) + c_gap * rows(4);
+      vel = (rows(2) + (pair(g + 2) * fx + pair(g + 6) * fy)) + c_gap * rows(6);
+    }
+    steps_ += n;
+    u_ << pos[0], pos[1], vel[0], vel[1];
   }
   // Whether step_block may take its held-inputs path; the rate and the
   // temperature it holds when so.
