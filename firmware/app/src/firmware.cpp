@@ -140,7 +140,9 @@ void Firmware::judge_calibration_parts() {
   const double t_s = st.chain.t_s;
   if (guard_.judge(estimator_.health(), checking(), t_s, st.pump_edge.verdict)) {
     // The chain goes back to the raw pickoffs; the verdict stays reported.
+    // A seed's model kept beside a damping part takes over.
     chain_.clear_electronics_correction();
+    estimator_.fall_back_to_seed_model();
     put_in_force(kIdentityCalibration, true);
     return;
   }
