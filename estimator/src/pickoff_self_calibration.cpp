@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "estimator/augmented_least_squares.hpp"
 #include "estimator/conditioning.hpp"
 
 namespace hrg::est {
@@ -22,34 +23,6 @@ constexpr int kHc = 5;
 constexpr int kHs = 6;
 // Column of the quadrature row.
 constexpr int kPhi = 2;
-
-// Window sums to the window's contribution with its offset removed.
-template <int N>
-Eigen::Matrix<double, N, N> centred(const Eigen::Matrix<double, N, 1>& m,
-                                    const Eigen::Matrix<double, N, N>& mm, double n) {
-  return mm - m * m.transpose() / n;
-}
-
-// Least squares on an augmented state [N b; b' yy] restricted to columns
-// [first, first + K): solution, residual sum of squares, inverse of N.
-template <int K, int A>
-struct Fit {
-  Eigen::Matrix<double, K, 1> p;
-  Eigen::Matrix<double, K, K> n_inv;
-  double rss;
-};
-
-template <int K, int A>
-Fit<K, A> fit(const Eigen::Matrix<double, A, A>& aug, int first) {
-  const Eigen::Matrix<double, K, K> n = aug.template block<K, K>(first, first);
-  const Eigen::Matrix<double, K, 1> b = aug.template block<K, 1>(first, A - 1);
-  const Eigen::LDLT<Eigen::Matrix<double, K, K>> ldlt(n);
-  Fit<K, A> f;
-  f.p = ldlt.solve(b);
-  f.n_inv = ldlt.solve(Eigen::Matrix<double, K, K>::Identity());
-  f.rss = std::max(0.0, aug(A - 1, A - 1) - f.p.dot(b));
-  return f;
-}
 
 // Subtracts sum_j d_j z_j from the observation of an augmented state
 // (y' = y - d.z), exact on the accumulated sums: A' = T A T'.
@@ -191,9 +164,9 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
     r.status = Status::ill_conditioned;
     return r;
   }
-  const Fit<kE, kE + 1> e = fit<kE, kE + 1>(ae_, 0);
-  const Fit<kQ, kQ + 1> q = fit<kQ, kQ + 1>(aq_, 0);
-  const Fit<kE - 1, kE + 1> d = fit<kE - 1, kE + 1>(ad_, 1);
+  const AugmentedFit<kE> e = fit_augmented<kE, kE + 1>(ae_, 0);
+  const AugmentedFit<kQ> q = fit_augmented<kQ, kQ + 1>(aq_, 0);
+  const AugmentedFit<kE - 1> d = fit_augmented<kE - 1, kE + 1>(ad_, 1);
   const double var = e.rss / dof;
   const double var_q = q.rss / dof_quad;
   const double rho = e.p(kRho);

@@ -34,32 +34,71 @@ est::ControlDriftEstimator::Sample control_sample(const ChainRecord& s, double d
 
 void EstimatorPort::begin_window(double t_s) {
   (void)est_.begin_window(t_s);
+  if (shadow_) (void)seed_est_.begin_window(t_s);
   (void)self_cal_.begin_window();
+  model_check_.begin_window();
 }
 
-void EstimatorPort::end_self_cal_window() {
+void EstimatorPort::end_side_windows() {
   if (self_cal_.end_window() == est::Status::ok) self_cal_dirty_ = true;
+  if (model_check_.end_window() == est::Status::ok) check_dirty_ = true;
 }
 
-void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& applied) {
+void EstimatorPort::set_resonator_model(const Calibration& cal) {
+  const bool same_damping = cal.thermal_damping_per_c == model_.thermal_damping_per_c &&
+                            cal.temperature_ref_c == model_.temperature_ref_c &&
+                            cal.nonlinear_damping_per_v2 == model_.nonlinear_damping_per_v2;
+  model_ = cal;
+  if (same_damping) return;
+  model_check_.reset();
+  model_check_result_ = {};
+  check_dirty_ = false;
+  // Until the check has judged a damping part, the seed's model is
+  // identified beside it from the same windows (from what is known now).
+  shadow_ = has_damping_model(cal);
+  if (shadow_) seed_est_ = est_;
+}
+
+void EstimatorPort::fall_back_to_seed_model() {
+  if (!shadow_) return;
+  shadow_ = false;
+  est_ = seed_est_;
+  dirty_ = true;  // solved again at the next solve()
+  health_.window_misfit = est_.last_window_misfit();
+  health_.windows_checked = est_.windows_checked();
+}
+
+void EstimatorPort::restart_model() {
   est_ = est::Estimator(cfg_);
-  self_cal_.refer_to_applied(applied);
-  self_cal_result_ = {};
-  self_cal_dirty_ = true;  // the re-referred residual, solved at the next solve()
+  if (shadow_) seed_est_ = est_;
   health_ = {};
   dirty_ = false;
   last_control_t_s_ = -1.0;
+}
+
+void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& applied) {
+  restart_model();
+  self_cal_.refer_to_applied(applied);
+  self_cal_result_ = {};
+  self_cal_dirty_ = true;  // the re-referred residual, solved at the next solve()
+  // The windows' levels changed with the correction, their decay did not:
+  // the damping model check keeps them.
 }
 
 void EstimatorPort::add_sample(const ChainRecord& s) {
   // Settling samples and sequencing errors are the accumulator's to count;
   // the self-calibration takes the samples the accumulator took.
   const est::WaveSample w = wave_sample(s, damping_scale(s.wave.E_v2));
-  if (est_.add_sample(w) == est::Status::ok) (void)self_cal_.add_sample(w);
+  if (shadow_) (void)seed_est_.add_sample(wave_sample(s, 1.0));
+  if (est_.add_sample(w) == est::Status::ok) {
+    (void)self_cal_.add_sample(w);
+    (void)model_check_.add_sample(w);
+  }
 }
 
 void EstimatorPort::end_window() {
-  end_self_cal_window();
+  end_side_windows();
+  if (shadow_) (void)seed_est_.end_window();
   if (est_.end_window() == est::Status::ok) {
     ++windows_ok_;
     dirty_ = true;
@@ -71,7 +110,8 @@ void EstimatorPort::end_window() {
 }
 
 void EstimatorPort::end_check_window() {
-  end_self_cal_window();
+  end_side_windows();
+  if (shadow_) (void)seed_est_.end_window(false);
   if (est_.end_window(false) == est::Status::ok) {
     ++windows_ok_;  // accepted as a check (nothing new to solve)
     health_.window_misfit = est_.last_window_misfit();
@@ -85,21 +125,30 @@ void EstimatorPort::abort_window() {
   // A window cut short by a fault is dropped: its last samples may already
   // show the fault, and a short window is worth little anyway.
   self_cal_.abort_window();
+  model_check_.abort_window();
+  if (shadow_ && seed_est_.window().window_open()) seed_est_.abort_window();
   if (!est_.window().window_open()) return;
   est_.abort_window();
   ++windows_bad_;
 }
 
 void EstimatorPort::add_control_sample(const ChainRecord& s) {
-  // The D_Phi fits take the identified decay and split as known: before a
-  // model is accepted they would fold in a wrong one.
-  if (!est_.has_model()) return;
   // Samples are taken every control period in operate; a gap (a window, a
   // commanded pattern move) ends the derivative blocks first.
-  if (s.t_s - last_control_t_s_ > kMaxControlGapS) est_.restart_control();
+  const bool gap = s.t_s - last_control_t_s_ > kMaxControlGapS;
   last_control_t_s_ = s.t_s;
+  add_control_sample(est_, s, damping_scale(s.wave.E_v2), gap);
+  if (shadow_) add_control_sample(seed_est_, s, 1.0, gap);
+}
+
+void EstimatorPort::add_control_sample(est::Estimator& e, const ChainRecord& s, double scale,
+                                       bool gap) {
+  // The D_Phi fits take the identified decay and split as known: before a
+  // model is accepted they would fold in a wrong one.
+  if (!e.has_model()) return;
+  if (gap) e.restart_control();
   // A bad sample restarts the estimate (the estimator's rule).
-  (void)est_.add_control_sample(control_sample(s, damping_scale(s.wave.E_v2)));
+  (void)e.add_control_sample(control_sample(s, scale));
 }
 
 double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {
@@ -111,8 +160,13 @@ void EstimatorPort::solve() {
     self_cal_dirty_ = false;
     self_cal_result_ = self_cal_.solve();
   }
+  if (check_dirty_) {
+    check_dirty_ = false;
+    model_check_result_ = model_check_.solve();
+  }
   if (!dirty_) return;
   dirty_ = false;
+  if (shadow_) (void)seed_est_.solve_and_accept();
   const est::Solution s = est_.solve_and_accept();
   if (s.accepted()) ++solves_ok_;
   health_.solved = est_.has_model();

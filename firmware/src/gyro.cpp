@@ -331,6 +331,9 @@ void Gyro::task_telemetry(Gyro& g) {
   s.fault_input = st.fault_input;
   s.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
   s.comp_valid = st.compensation_valid;
+  s.cal_withdrawn = g.calibration_flags_.withdrawn;
+  s.cal_damping_refuted = g.calibration_flags_.damping_refuted;
+  s.cal_gap_refuted = g.calibration_flags_.gap_refuted;
   s.faults = static_cast<uint16_t>(st.faults | g.mode_.faults());
   const Identification id = g.identifier_.identification();
   s.nu_per_s = id.p[0];

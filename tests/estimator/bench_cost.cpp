@@ -2,7 +2,9 @@
 // Cost of the estimator's steps, for callgrind (bench_cost.cmake counts the
 // instructions inside each hrg_bench_est_* function and divides by its count).
 //   bench_estimator_cost <op> <count>
-//   op: sample | window | solve | solve_alt | output | selfcal_sample | selfcal_solve
+//   op: sample | window | solve | solve_alt | output | selfcal_sample | selfcal_solve |
+//       modelcheck_sample | modelcheck_solve
+#include <estimator/damping_model_check.hpp>
 #include <estimator/estimator.hpp>
 #include <estimator/pickoff_self_calibration.hpp>
 
@@ -37,6 +39,8 @@ std::vector<WaveSample> window_samples(double theta0, double t0) {
 extern "C" {
 void hrg_bench_selfcal_sample(PickoffSelfCalibration& cal, const WaveSample* s, int n);
 PickoffSelfCalResult hrg_bench_selfcal_solve(const PickoffSelfCalibration& cal);
+void hrg_bench_modelcheck_sample(DampingModelCheck& c, const WaveSample* s, int n);
+DampingModelCheckResult hrg_bench_modelcheck_solve(const DampingModelCheck& c);
 }
 
 namespace {
@@ -70,6 +74,37 @@ int run_self_calibration(const char* op, int count) {
   std::printf("%s %d %.3e\n", op, count, sink);
   return 0;
 }
+
+// 16 windows at different temperatures (a damping scale of +-0.4 % on a
+// cycle of 7 windows), then the op.
+int run_model_check(const char* op, int count) {
+  DampingModelCheck check;
+  const bool sample_op = std::strcmp(op, "modelcheck_sample") == 0;
+  double sink = 0;
+  for (int k = 0; k < 16; ++k) {
+    auto samples = window_samples(0.05 + k * M_PI / 32, 10.0 * k);
+    for (auto& s : samples)
+      s.damping_scale = 1.0 + 0.004 * std::sin(2.0 * M_PI * k / 7.0);
+    const int reps = sample_op && k == 15 ? count : 1;
+    for (int r = 0; r < reps; ++r) {
+      check.abort_window();
+      check.begin_window();
+      if (sample_op && k == 15) {
+        hrg_bench_modelcheck_sample(check, samples.data(), kWindowSamples);
+      } else {
+        for (const auto& s : samples)
+          check.add_sample(s);
+      }
+    }
+    check.end_window();
+  }
+  if (!sample_op) {
+    for (int r = 0; r < count; ++r)
+      sink += hrg_bench_modelcheck_solve(check).factor;
+  }
+  std::printf("%s %d %.3e\n", op, count, sink);
+  return 0;
+}
 }  // namespace
 
 extern "C" {
@@ -97,6 +132,17 @@ __attribute__((noipa)) PickoffSelfCalResult hrg_bench_selfcal_solve(
     const PickoffSelfCalibration& cal) {
   return cal.solve();
 }
+// The damping model check's per-sample step (beside add_sample while a
+// calibration with a damping part is in force) and its solve.
+__attribute__((noipa)) void hrg_bench_modelcheck_sample(DampingModelCheck& c, const WaveSample* s,
+                                                        int n) {
+  for (int i = 0; i < n; ++i)
+    c.add_sample(s[i]);
+}
+__attribute__((noipa)) DampingModelCheckResult hrg_bench_modelcheck_solve(
+    const DampingModelCheck& c) {
+  return c.solve();
+}
 __attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n) {
   double c = 0;
   for (int i = 0; i < n; ++i)
@@ -108,14 +154,15 @@ __attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n
 int main(int argc, char** argv) {
   if (argc != 3) {
     std::fprintf(stderr,
-                 "usage: %s sample|window|solve|solve_alt|output|selfcal_sample|selfcal_solve "
-                 "<count>\n",
+                 "usage: %s sample|window|solve|solve_alt|output|selfcal_sample|selfcal_solve|"
+                 "modelcheck_sample|modelcheck_solve <count>\n",
                  argv[0]);
     return 2;
   }
   const char* op = argv[1];
   const int count = std::atoi(argv[2]);
   if (std::strncmp(op, "selfcal", 7) == 0) return run_self_calibration(op, count);
+  if (std::strncmp(op, "modelcheck", 10) == 0) return run_model_check(op, count);
   // A well-covered state to solve: 16 windows.
   NormalEquations ls;
   WindowAccumulator acc;

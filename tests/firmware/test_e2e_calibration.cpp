@@ -292,4 +292,17 @@ TEST(CalibrationLoop, AGapHarmonicOfTheWrongSignIsRefutedOnlineAndDoesNoHarm) {
   CHECK(r.fit_comp.ok && r.fit_raw.ok);
   CHECK(r.fit_comp.amplitude() < 0.5 * wrong_dph);
   CHECK(!r.compensation_valid || r.fit_comp.amplitude() < r.fit_raw.amplitude());
+  // AND the run says so: the refutation is in the calibration's status (the
+  // report's compensation.calibration and a failure line), and the gap in
+  // force at the end is none (the online fit).
+  std::printf("\n  gap refuted %d at %.1f s\n", r.calibration.gap_refuted ? 1 : 0,
+              r.calibration.gap_refuted_s);
+  CHECK(r.calibration.gap_refuted);
+  CHECK(r.calibration.gap_refuted_s > 0.0);
+  DOUBLES_EQUAL(0.0, r.final_calibration.gap_eps_p, 0.0);
+  DOUBLES_EQUAL(0.0, r.final_calibration.gap_eps_q, 0.0);
+  bool said = false;
+  for (const std::string& f : r.failures)
+    said = said || f.find("gap harmonic was refuted") != std::string::npos;
+  CHECK(said);
 }

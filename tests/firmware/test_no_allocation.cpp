@@ -86,3 +86,31 @@ TEST(NoAllocation, TheGyroWithTheEstimatorAllocatesNothingThroughWindowsAndSolve
         g.status().mode == Mode::recover);
   LONGS_EQUAL(0, counter.count());
 }
+
+TEST(NoAllocation, TheDampingModelCheckAndTheSeedModelBesideItAllocateNothing) {
+  hrg::fakes::FakeChain chain;
+  chain.theta_rate_rad_per_block = 2e-4;
+  chain.decay_per_block = 3e-6;
+  hrg::est::Estimator::Config ec;
+  hrg::fw::EstimatorPort ident(ec);
+  // A damping part (nonlinear damping: the scale follows the wave's energy
+  // without a temperature sensor) puts the check and the seed's model to work.
+  hrg::fw::Calibration cal{};
+  cal.nonlinear_damping_per_v2 = 0.05;
+  ident.set_resonator_model(cal);
+  CHECK(ident.seed_model_kept());
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, config());
+  counter.install();
+  Eigen::internal::set_is_malloc_allowed(false);
+  for (int i = 0; i < 6000; ++i)
+    g.run_frame();
+  ident.fall_back_to_seed_model();
+  for (int i = 0; i < 1000; ++i)
+    g.run_frame();
+  Eigen::internal::set_is_malloc_allowed(true);
+  counter.uninstall();
+  CHECK(ident.windows_accepted() >= 10);
+  CHECK(ident.damping_model_check().windows >= 10);
+  CHECK(!ident.seed_model_kept());
+  LONGS_EQUAL(0, counter.count());
+}

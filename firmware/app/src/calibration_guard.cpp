@@ -25,7 +25,7 @@ const char* to_string(CalibrationVerdict v) {
 
 void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool identity,
                                bool feedthrough, double t_s, const EstimatorHealth& h,
-                               bool checking) {
+                               bool checking, bool damping_model) {
   const uint32_t withdrawals = status_.withdrawals;
   status_ = CalibrationStatus{};
   status_.withdrawals = withdrawals;
@@ -34,6 +34,7 @@ void CalibrationGuard::applied(CalibrationSource source, uint32_t crc32, bool id
   status_.crc32 = crc32;
   status_.applied_s = t_s;
   status_.feedthrough = !identity && feedthrough;
+  status_.damping_model = damping_model;
   // A check made before (with the previous correction) is the reference
   // the new one must not be worse than.
   status_.misfit_before = checking && h.windows_checked > 0 ? h.window_misfit : 0.0;
@@ -78,6 +79,24 @@ bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s
   }
   if (edge_ok) status_.verdict = CalibrationVerdict::confirmed;
   return false;
+}
+
+bool CalibrationGuard::judge_damping_model(double factor, double factor_sigma, bool refuted,
+                                           double t_s) {
+  if (!status_.damping_model || status_.damping_refuted) return false;
+  status_.damping_factor = factor;
+  status_.damping_factor_sigma = factor_sigma;
+  if (!refuted) return false;
+  status_.damping_refuted = true;
+  status_.damping_refuted_s = t_s;
+  return true;
+}
+
+bool CalibrationGuard::judge_gap(bool refuted, double t_s) {
+  if (!refuted || status_.gap_refuted) return false;
+  status_.gap_refuted = true;
+  status_.gap_refuted_s = t_s;
+  return true;
 }
 
 }  // namespace hrg::fw::app

@@ -21,6 +21,25 @@ bool is_identity_resonator(const Calibration& cal) {
          cal.nonlinear_damping_per_v2 == 0.0;
 }
 
+bool same_electronics(const Calibration& a, const Calibration& b) {
+  return a.pickoff_y_gain == b.pickoff_y_gain && a.pickoff_y_phase_rad == b.pickoff_y_phase_rad &&
+         a.pickoff_y_misalignment_rad == b.pickoff_y_misalignment_rad &&
+         a.feedthrough_x_re_v_per_v == b.feedthrough_x_re_v_per_v &&
+         a.feedthrough_x_im_v_per_v == b.feedthrough_x_im_v_per_v &&
+         a.feedthrough_y_re_v_per_v == b.feedthrough_y_re_v_per_v &&
+         a.feedthrough_y_im_v_per_v == b.feedthrough_y_im_v_per_v;
+}
+
+// `cal` without its resonator model (the seed's model instead).
+Calibration without_resonator_model(Calibration cal) {
+  cal.thermal_frequency_ppm_per_c = 0.0;
+  cal.thermal_damping_per_c = 0.0;
+  cal.duffing_hz_per_v2 = 0.0;
+  cal.electrostatic_spring_hz_per_v2 = 0.0;
+  cal.nonlinear_damping_per_v2 = 0.0;
+  return cal;
+}
+
 bool has_feedthrough(const Calibration& cal) {
   return cal.feedthrough_x_re_v_per_v != 0.0 || cal.feedthrough_x_im_v_per_v != 0.0 ||
          cal.feedthrough_y_re_v_per_v != 0.0 || cal.feedthrough_y_im_v_per_v != 0.0;
@@ -57,13 +76,19 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
   } else if (!chain_.set_electronics_correction(pickoff, feedthrough_coefficients(cal))) {
     return false;
   }
+  put_in_force(cal, !same_electronics(cal, cfg_.calibration));
+  guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
+                 has_feedthrough(cal), gyro_.status().chain.t_s, estimator_.health(), checking(),
+                 has_damping_model(cal));
+  return true;
+}
+
+void Firmware::put_in_force(const Calibration& cal, bool electronics_changed) {
   cfg_.calibration = cal;
   estimator_.set_resonator_model(cal);
   estimator_.set_known_gap(cal.gap_eps_p, cal.gap_eps_q);
-  gyro_.restart_pump_edge_check();
-  guard_.applied(source, calibration_crc(cal), identity && is_identity_resonator(cal),
-                 has_feedthrough(cal), gyro_.status().chain.t_s, estimator_.health(), checking());
-  return true;
+  // The switch-off steps of a signal corrected otherwise start again.
+  if (electronics_changed) gyro_.restart_pump_edge_check();
 }
 
 bool Firmware::checking() const {
@@ -103,14 +128,47 @@ void Firmware::self_calibrate() {
 }
 
 void Firmware::judge_calibration() {
+  judge_calibration_parts();
+  const CalibrationStatus& c = guard_.status();
+  gyro_.set_calibration_flags({.withdrawn = c.verdict == CalibrationVerdict::withdrawn,
+                               .damping_refuted = c.damping_refuted,
+                               .gap_refuted = c.gap_refuted});
+}
+
+void Firmware::judge_calibration_parts() {
   const GyroStatus& st = gyro_.status();
-  if (!guard_.judge(estimator_.health(), checking(), st.chain.t_s, st.pump_edge.verdict)) return;
-  // The chain goes back to the raw pickoffs; the verdict stays reported.
-  chain_.clear_electronics_correction();
-  cfg_.calibration = kIdentityCalibration;
-  estimator_.set_resonator_model(kIdentityCalibration);
-  gyro_.restart_pump_edge_check();
-  estimator_.set_known_gap(0.0, 0.0);
+  const double t_s = st.chain.t_s;
+  if (guard_.judge(estimator_.health(), checking(), t_s, st.pump_edge.verdict)) {
+    // The chain goes back to the raw pickoffs; the verdict stays reported.
+    // A seed's model kept beside a damping part takes over.
+    chain_.clear_electronics_correction();
+    estimator_.fall_back_to_seed_model();
+    put_in_force(kIdentityCalibration, true);
+    return;
+  }
+  const est::DampingModelCheckResult& d = estimator_.damping_model_check();
+  if (d.status == est::Status::ok && d.supported) estimator_.keep_resonator_model();
+  if (d.status == est::Status::ok &&
+      guard_.judge_damping_model(d.factor, d.factor_sigma, d.refuted, t_s)) {
+    // The seed's model from now on, the one identified beside it from the
+    // same windows; when none was kept (the check had supported the part
+    // before), the model starts again.
+    const bool kept = estimator_.seed_model_kept();
+    estimator_.fall_back_to_seed_model();
+    put_in_force(without_resonator_model(cfg_.calibration), false);
+    if (!kept) {
+      estimator_.restart_model();
+      gyro_.restart_identification();
+    }
+  }
+  if (guard_.judge_gap(estimator_.estimator().known_gap_refuted(), t_s)) {
+    // The online fit of the pump's drift for the rest of the run (the
+    // estimator has switched to it already; kept across model restarts).
+    Calibration no_gap = cfg_.calibration;
+    no_gap.gap_eps_p = 0.0;
+    no_gap.gap_eps_q = 0.0;
+    put_in_force(no_gap, false);
+  }
 }
 
 }  // namespace hrg::fw::app

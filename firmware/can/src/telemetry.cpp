@@ -80,6 +80,9 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::fault_input, b(s.fault_input), f);
       put(m, sig::ident_active, b(s.ident_active), f);
       put(m, sig::comp_valid, b(s.comp_valid), f);
+      put(m, sig::cal_withdrawn, b(s.cal_withdrawn), f);
+      put(m, sig::cal_damping_refuted, b(s.cal_damping_refuted), f);
+      put(m, sig::cal_gap_refuted, b(s.cal_gap_refuted), f);
       put(m, sig::faults, s.faults, f);
       put(m, sig::temp_c, s.temp_c, f);
       break;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "estimator/damping_model_check.hpp"
 #include "estimator/estimator.hpp"
 #include "estimator/pickoff_self_calibration.hpp"
 #include "firmware/calibration.hpp"
@@ -13,7 +14,8 @@ namespace hrg::fw {
 // accepts the model when the conditioning allows, the drift is eq. 22.
 class EstimatorPort final : public ResonatorIdentifier {
  public:
-  explicit EstimatorPort(const est::Estimator::Config& cfg) : cfg_(cfg), est_(cfg) {}
+  explicit EstimatorPort(const est::Estimator::Config& cfg)
+      : cfg_(cfg), est_(cfg), seed_est_(cfg) {}
 
   void begin_window(double t_s) override;
   void add_sample(const ChainRecord& s) override;
@@ -34,8 +36,9 @@ class EstimatorPort final : public ResonatorIdentifier {
   // temperature, nonlinear damping) that the windows' regressors and the
   // drift are referred to: the identified damping is the reference
   // state's, so a known change of the common damping with temperature or
-  // amplitude is not taken for anisotropy. Call between windows.
-  void set_resonator_model(const Calibration& cal) { model_ = cal; }
+  // amplitude is not taken for anisotropy. Call between windows. A new
+  // damping part starts its check (damping_model_check) again.
+  void set_resonator_model(const Calibration& cal);
   // The known factor on the whole damping now, at energy e_v2 (V^2) and the
   // measured temperature (the reference temperature without a sensor).
   double damping_scale(double e_v2) const {
@@ -48,6 +51,22 @@ class EstimatorPort final : public ResonatorIdentifier {
   // The pickoff self-calibration over the same windows (campaign and check
   // windows alike): its last solve (re-solved after every window).
   const est::PickoffSelfCalResult& pickoff_self_calibration() const { return self_cal_result_; }
+  // Do no harm for the resonator model: whether its damping terms fit the
+  // windows (campaign and check windows alike) better than none
+  // (est::DampingModelCheck), re-solved after every window.
+  const est::DampingModelCheckResult& damping_model_check() const { return model_check_result_; }
+  // The model and D_Phi forget every window (the signals or the model they
+  // are referred to changed); the self-calibration keeps its windows.
+  void restart_model();
+  // The damping model check refuted the resonator model's damping part: the
+  // seed's model identified beside it from the same windows (k = 1) takes
+  // over, nothing is lost (the caller then sets the model without its
+  // damping part). Until the check has judged the part (refuted or
+  // supported) every window and control sample goes to both.
+  void fall_back_to_seed_model();
+  // The check supports the damping part: the seed's model is no longer kept.
+  void keep_resonator_model() { shadow_ = false; }
+  bool seed_model_kept() const { return shadow_; }
   // A new pickoff correction (`applied`, a self-calibration result, on top of
   // the one in force) changed the signals: the model and D_Phi forget every
   // window; the self-calibration keeps them, re-referred through it
@@ -58,24 +77,33 @@ class EstimatorPort final : public ResonatorIdentifier {
   void set_known_gap(double eps_p, double eps_q) {
     cfg_.gap = {eps_p, eps_q};
     est_.set_known_gap(cfg_.gap);
+    seed_est_.set_known_gap(cfg_.gap);
   }
   uint32_t windows_accepted() const { return windows_ok_; }
   uint32_t windows_rejected() const { return windows_bad_; }
   uint32_t solves_accepted() const { return solves_ok_; }
 
  private:
-  void end_self_cal_window();
+  void end_side_windows();
+  void add_control_sample(est::Estimator& e, const ChainRecord& s, double scale, bool gap);
 
   est::Estimator::Config cfg_;
   est::Estimator est_;
+  // The seed's model (k = 1) from the same windows while a damping part is
+  // on trial (shadow_).
+  est::Estimator seed_est_;
+  bool shadow_ = false;
   Calibration model_{};  // its resonator part is used here
   double temp_c_ = 0.0;
   bool temp_valid_ = false;
   est::PickoffSelfCalibration self_cal_;
   est::PickoffSelfCalResult self_cal_result_{};
+  est::DampingModelCheck model_check_;
+  est::DampingModelCheckResult model_check_result_{};
   EstimatorHealth health_{};
   bool dirty_ = false;           // a window was added since the last solve
   bool self_cal_dirty_ = false;  // a window was added to the self-calibration
+  bool check_dirty_ = false;     // a window was added to the damping model check
   // Control samples further apart than this (s) restart the D_Phi blocks.
   static constexpr double kMaxControlGapS = 0.0015;
   double last_control_t_s_ = -1.0;

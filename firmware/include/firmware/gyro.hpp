@@ -158,6 +158,13 @@ class Gyro {
     link_.calibration().set_apply(apply_fn, context);
     link_.calibration().set_active(active);
   }
+  // What the calibration checks (firmware/app) found, for HRG_STATUS.
+  struct CalibrationFlags {
+    bool withdrawn = false;        // the correction of the pickoffs was withdrawn
+    bool damping_refuted = false;  // the damping model was refuted
+    bool gap_refuted = false;      // the gap harmonic was refuted
+  };
+  void set_calibration_flags(const CalibrationFlags& f) { calibration_flags_ = f; }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);
@@ -195,6 +202,7 @@ class Gyro {
   PumpEdgeCheck pump_edge_;
   can::TelemetryEncoder telemetry_{can::TelemetryConfig::defaults(), kBaseRateHz};
   can::TelemetrySnapshot snapshot_{};
+  CalibrationFlags calibration_flags_{};
   can::EnvelopeReference envelope_;
   can::CanLink link_;
   ChainCommands commands_{};

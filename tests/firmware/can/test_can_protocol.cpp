@@ -119,6 +119,7 @@ TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
   s.fault_input = false;
   s.ident_active = true;
   s.comp_valid = true;
+  s.cal_damping_refuted = true;
   s.faults = static_cast<uint16_t>(hrg::fw::fault_bit(hrg::fw::Fault::adc_stuck) |
                                    hrg::fw::fault_bit(hrg::fw::Fault::external));
   s.temp_c = 32.26;
@@ -169,6 +170,9 @@ TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
       {Tm::status, "fault_input", 0},
       {Tm::status, "ident_active", 1},
       {Tm::status, "comp_valid", 1},
+      {Tm::status, "cal_withdrawn", 0},
+      {Tm::status, "cal_damping_refuted", 1},
+      {Tm::status, "cal_gap_refuted", 0},
       {Tm::status, "faults", 8 + 64},
       {Tm::status, "temp_c", 32.26},
       {Tm::est_damping, "nu_per_s", 3.14159e-3},

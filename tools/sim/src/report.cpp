@@ -109,6 +109,21 @@ bool judge(const RunConfig& job, RunResult& r) {
               job.firmware.gyro.max_window_misfit, before.c_str()));
     }
   }
+  if (r.calibration.damping_refuted) {
+    const fw::app::CalibrationStatus& c = r.calibration;
+    r.failures.push_back(
+        fmt("the calibration's damping model was refuted at %.1f s: the free decays show "
+            "%.2f +- %.2f of the damping change it predicts (1 if it held, below 0.5 it "
+            "fits worse than none); the seed's model is used and identified again",
+            c.damping_refuted_s, c.damping_factor, c.damping_factor_sigma));
+  }
+  if (r.calibration.gap_refuted) {
+    r.failures.push_back(
+        fmt("the calibration's gap harmonic was refuted at %.1f s: the online fit of the "
+            "pump's drift stands %.1f of its sigmas or more away from it; the online fit "
+            "is used",
+            r.calibration.gap_refuted_s, job.firmware.estimator.pump.min_gap_sigmas));
+  }
   if (r.pump_edge.verdict == fw::PumpEdgeVerdict::step) {
     r.failures.push_back(
         fmt("the drift compensation is not valid: the corrected signal steps by %.3g V "
@@ -170,6 +185,19 @@ void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
   w.number("misfit_after", c.misfit_after);
   w.number("judged_s", c.judged_s);
   w.integer("withdrawals", c.withdrawals);
+  // The resonator model's damping part (its own check on every window) and
+  // the gap harmonic (against the online fit), each refuted or not.
+  w.boolean("damping_model", c.damping_model);
+  w.boolean("damping_refuted", c.damping_refuted);
+  w.number("damping_factor", c.damping_factor);
+  w.number("damping_factor_sigma", c.damping_factor_sigma);
+  w.number("damping_refuted_s", c.damping_refuted_s);
+  w.number("thermal_damping_per_c", in_force.thermal_damping_per_c);
+  w.number("nonlinear_damping_per_v2", in_force.nonlinear_damping_per_v2);
+  w.boolean("gap_refuted", c.gap_refuted);
+  w.number("gap_refuted_s", c.gap_refuted_s);
+  w.number("gap_eps_p", in_force.gap_eps_p);
+  w.number("gap_eps_q", in_force.gap_eps_q);
   w.end_object();
 }
 

@@ -128,5 +128,9 @@ double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c,
 // Factor on the whole damping (mean and anisotropy): (1 + beta (T - T0))(1 + eta E),
 // E = a_A^2 + a_B^2 (V^2 of pickoff).
 double damping_scale(const Calibration& c, double temp_c, double e_v2);
+// It has a damping part (damping_scale is not 1 everywhere).
+constexpr bool has_damping_model(const Calibration& c) {
+  return c.thermal_damping_per_c != 0.0 || c.nonlinear_damping_per_v2 != 0.0;
+}
 
 }  // namespace hrg::fw

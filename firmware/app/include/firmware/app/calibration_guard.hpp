@@ -49,6 +49,18 @@ struct CalibrationStatus {
   // The switch-off step check at the verdict (a withdrawal by a step: `step`).
   PumpEdgeVerdict edge = PumpEdgeVerdict::unknown;
   uint32_t withdrawals = 0;  // calibrations withdrawn since start
+  // The resonator model's damping part (est::DampingModelCheck), judged on
+  // every window while in force: refuted when its terms fit the decays
+  // significantly worse than none; the seed's model is then used.
+  bool damping_model = false;    // the calibration in force has one
+  bool damping_refuted = false;  // it was refuted (and taken out)
+  double damping_factor = 0.0;   // how much of its damping change the windows show (1: all)
+  double damping_factor_sigma = 0.0;
+  double damping_refuted_s = 0.0;
+  // The gap harmonic disagreed with the online fit of the pump's drift
+  // (est::Estimator::known_gap_refuted): taken out, the online fit used.
+  bool gap_refuted = false;
+  double gap_refuted_s = 0.0;
 };
 
 class CalibrationGuard {
@@ -59,8 +71,9 @@ class CalibrationGuard {
   // estimator's health at that instant, `checking`: its check windows count
   // (the campaign is over).
   // `feedthrough`: it changes the feedthrough removal.
+  // `damping_model`: it has a damping part (thermal or nonlinear damping).
   void applied(CalibrationSource source, uint32_t crc32, bool identity, bool feedthrough,
-               double t_s, const EstimatorHealth& h, bool checking);
+               double t_s, const EstimatorHealth& h, bool checking, bool damping_model = false);
   // Once per frame, with the switch-off step check's verdict (reset when the
   // calibration was applied). True when the calibration in force must be
   // withdrawn now.
@@ -73,6 +86,11 @@ class CalibrationGuard {
   bool judge(const EstimatorHealth& h, bool checking, double t_s) {
     return judge(h, checking, t_s, PumpEdgeVerdict::unknown);
   }
+  // The damping model check's latest result while the calibration's damping
+  // part is in force: true when it must be taken out now (once).
+  bool judge_damping_model(double factor, double factor_sigma, bool refuted, double t_s);
+  // The estimator has refuted the calibration's gap harmonic: true once.
+  bool judge_gap(bool refuted, double t_s);
 
   const CalibrationStatus& status() const { return status_; }
 

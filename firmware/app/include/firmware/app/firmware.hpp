@@ -83,8 +83,15 @@ class Firmware {
   const FirmwareConfig& config() const { return cfg_; }
 
  private:
-  // Withdraws the calibration in force when its check window disagreed.
+  // Withdraws the calibration in force when its check window disagreed,
+  // takes out its damping model or its gap harmonic when their checks
+  // refute them.
   void judge_calibration();
+  void judge_calibration_parts();
+  // Puts the parts of `cal` beyond the chain in force: the resonator model
+  // (estimator regressors and drift), the known gap harmonic, and, when the
+  // electronics correction changed, a fresh switch-off step check.
+  void put_in_force(const Calibration& cal, bool electronics_changed);
   // Folds a fresh, significant self-calibration estimate into the
   // correction and starts the identification again.
   void self_calibrate();

@@ -86,6 +86,9 @@ enum Status : uint8_t {
   fault_input,
   ident_active,
   comp_valid,
+  cal_withdrawn,
+  cal_damping_refuted,
+  cal_gap_refuted,
   faults,
   temp_c,
   status_seq

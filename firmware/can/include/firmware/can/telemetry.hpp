@@ -39,7 +39,12 @@ struct TelemetrySnapshot {
   bool fault_input = false;   // board fault input
   bool ident_active = false;  // identification (window schedule) running
   bool comp_valid = false;    // the drift compensation is in force and its model checks agree
-  uint16_t faults = 0;        // Fault bits
+  // Do no harm for a calibration: its correction of the pickoffs was
+  // withdrawn, its damping model or its gap harmonic refuted (each taken out).
+  bool cal_withdrawn = false;
+  bool cal_damping_refuted = false;
+  bool cal_gap_refuted = false;
+  uint16_t faults = 0;  // Fault bits
   double temp_c = 0;
   // Identification: p = (nu, dnu_C, dnu_S, dw_C, dw_S) of physics.md section 5.
   double nu_per_s = 0, dnu_c_per_s = 0, dnu_s_per_s = 0;
