@@ -152,12 +152,15 @@ void fit_scale_var(const Dataset& d, const std::vector<double>& res, ArNoise& ar
       last = j;
     }
     // Coarser scales have too few details to be estimated: the variance
-    // grows on as it grew from the white level to the last estimated scale
-    // (at most 2x per scale, 1/f noise's law for Haar details).
+    // grows on as it grew from the white level over the run of scales above
+    // it up to the last estimated one (at most 2x per scale, 1/f noise's law
+    // for Haar details); one scale above the white level alone (3 standard
+    // errors of chance among a dozen scales) is carried on, not grown.
+    const bool run = first != 0 && last > first;
     const double growth =
-        first == 0 ? 1.0
-                   : std::clamp(std::pow(lambda[last], 1.0 / static_cast<double>(last - first + 1)),
-                                1.0, 2.0);
+        run ? std::clamp(std::pow(lambda[last], 1.0 / static_cast<double>(last - first + 1)), 1.0,
+                         2.0)
+            : 1.0;
     for (std::size_t j = last + 1; j <= ArNoise::kScales; ++j)
       lambda[j] = lambda[j - 1] * growth;
   }
