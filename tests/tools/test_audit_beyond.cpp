@@ -175,3 +175,47 @@ TEST(AuditBeyondCatalogue, ThermalEffectAndDriftInTimeAreToldApartOrNotNamed) {
   CHECK_TEXT(c.verdict == "ambiguous" || c.verdict == "unexplained", text.c_str());
   CHECK(c.ambiguity_experiment.find("independently of time") != std::string::npos);
 }
+
+TEST(AuditBeyondCatalogue, ColouredNullWithALongDecayIsNotAFinding) {
+  // GIVEN a benchmark null (seed 4242, design 3: a ring-down with a 144 s
+  // decay, a reference that follows the resonance) with 1/f noise of corner
+  // 2.5 Hz, whose slowest octaves bend that decay's phase like a Duffing
+  // term (before the noise model held scales beyond the AR model's lags it
+  // was `explained` by -3.8e-7 Hz/V^2 at 8.9 sigma)
+  bench::Scenario s =
+      bench::random_scenario(bench::Design::ringdown, 480.0, 4242ULL * 100003ULL + 3);
+  s.pll_reference = true;
+  s.flicker_corner_hz = 2.5067;
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  // THEN nothing is found
+  CHECK_TEXT(r.findings.empty(), hrg::audit::to_text(r, "1/f null 4242/3").c_str());
+}
+
+TEST(AuditBeyondCatalogue, BenchmarkTemperatureDoesNotFollowTime) {
+  // GIVEN the benchmark's temperature (two cycles, their line in time taken
+  // out) over a 480 s run with a swing of 2 degC about 30 degC
+  bench::Scenario s = ringdown();
+  s.duration_s = 480.0;
+  s.temp_mean_c = 30.0;
+  s.temp_swing_c = 2.0;
+  s.temp_cycles = true;
+  for (double phase : {0.0, 1.0, 2.5}) {
+    const auto p = bench::temperature_profile(s, phase);
+    // WHEN sampled every 0.048 s (its 257 nodes every 1.875 s, linear between)
+    double st = 0, sT = 0, stt = 0, sTT = 0, stT = 0, peak = 0;
+    const int n = 10001;
+    for (int i = 0; i < n; ++i) {
+      const double t = 480.0 * i / (n - 1.0);
+      const double temp = p.value(t);
+      st += t, sT += temp, stt += t * t, sTT += temp * temp, stT += t * temp;
+      peak = std::max(peak, std::abs(temp - 30.0));
+    }
+    const double cov = stT / n - st / n * sT / n;
+    const double corr = cov / std::sqrt((stt / n - st * st / n / n) * (sTT / n - sT * sT / n / n));
+    // THEN it is uncorrelated with time (|r| < 0.01), swings by its swing
+    // and stays about its mean
+    CHECK(std::abs(corr) < 0.01);
+    DOUBLES_EQUAL(2.0, peak, 2e-3);
+    DOUBLES_EQUAL(30.0, sT / n, 0.01);
+  }
+}

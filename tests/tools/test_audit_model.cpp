@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Unit checks of the audit's model pieces and its input handling (fast).
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -149,4 +151,74 @@ TEST(AuditNoiseModel, ArModelWhitensAnAr1ResidualAndLeavesWhiteNoiseAlone) {
   for (double v : res)
     raw += v * v;
   CHECK(raw > chi2_w + 0.2 * 8000.0);
+}
+
+TEST(AuditNoiseModel, NoiseSlowerThanTheArModelIsHeldByItsScales) {
+  // GIVEN residuals of 8 free segments of 2048 blocks: on the x pickoff
+  // (channels 0-1) unit white noise plus 1/f-like noise, ten first-order
+  // processes of variance 0.1 with corners doubling from 1/4096 to 1/8 per
+  // block (density ~ 1/f between them), on the y pickoff unit white noise
+  hrg::audit::detail::Dataset d;
+  std::mt19937_64 g(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  constexpr int kBlocks = 2048;
+  std::vector<double> res;
+  for (int s = 0; s < 8; ++s) {
+    hrg::audit::detail::FreeSegment seg;
+    seg.first_block = static_cast<std::size_t>(s) * kBlocks;
+    seg.n_blocks = kBlocks;
+    d.free.push_back(seg);
+    std::array<std::array<double, 10>, 2> slow{};
+    for (auto& ch : slow)
+      for (double& x : ch)
+        x = std::sqrt(0.1) * n(g);
+    for (int b = 0; b < kBlocks; ++b) {
+      for (std::size_t c = 0; c < 4; ++c) {
+        double v = n(g);
+        for (std::size_t o = 0; c < 2 && o < 10; ++o) {
+          const double a =
+              std::exp(-2.0 * std::numbers::pi * std::ldexp(1.0, -12 + static_cast<int>(o)));
+          slow[c][o] = a * slow[c][o] + std::sqrt(0.1 * (1.0 - a * a)) * n(g);
+          v += slow[c][o];
+        }
+        res.push_back(v);
+      }
+    }
+  }
+  // WHEN the noise model is fitted
+  const auto m = hrg::audit::detail::fit_ar_noise(d, res);
+  // THEN the white pickoff's scales stay at the white level 1, and the 1/f
+  // pickoff's grow at the coarse ones (above 3x at 1024 blocks)
+  for (std::size_t j = 1; j <= hrg::audit::detail::ArNoise::kScales; ++j)
+    DOUBLES_EQUAL(1.0, m.scale_var[1][j], 0.0);
+  CHECK(m.scale_var[0][10] > 3.0);
+  // AND a slow structure (a parabola over each segment, raw chi^2 D; alone,
+  // the whitening being linear in the residuals) counts about D on the
+  // white pickoff (its innovation variance 1 to a few 0.016) and less than
+  // half of what the AR whitening alone counts on the 1/f pickoff: there
+  // most of it stands within the slow noise
+  auto parabola = [&](std::size_t channel, double& raw) {
+    std::vector<double> r(res.size(), 0.0);
+    raw = 0.0;
+    for (std::size_t s = 0; s < d.free.size(); ++s) {
+      for (int b = 0; b < kBlocks; ++b) {
+        const double u = 2.0 * b / (kBlocks - 1.0) - 1.0;
+        const double q = 0.35 * (u * u - 1.0 / 3.0);
+        r[4 * (s * kBlocks + static_cast<std::size_t>(b)) + channel] = q;
+        raw += q * q;
+      }
+    }
+    return r;
+  };
+  double dy = 0.0, dx = 0.0;
+  const auto qy = parabola(2, dy);
+  const auto qx = parabola(0, dx);
+  DOUBLES_EQUAL(dy, hrg::audit::detail::whitened_chi2(d, qy, m), 0.1 * dy);
+  auto ar_only = m;
+  for (auto& v : ar_only.scale_var)
+    v.fill(1.0);
+  const double count_x = hrg::audit::detail::whitened_chi2(d, qx, m);
+  const double count_x_ar = hrg::audit::detail::whitened_chi2(d, qx, ar_only);
+  CHECK_TEXT(count_x < 0.5 * count_x_ar,
+             (std::to_string(count_x) + " vs " + std::to_string(count_x_ar)).c_str());
 }

@@ -376,6 +376,9 @@ DesignPart run_design(const BenchOptions& o, int d) {
   // Every other round of the averaged-model designs is demodulated against
   // a reference that follows the resonance (f_ref_hz per row).
   base.pll_reference = kind != Design::firmware && (d / 3) % 2 == 1;
+  // A temperature that does not follow time, so that thermal effects can be
+  // told from drifts (the audit's step 8 leaves them ambiguous otherwise).
+  base.temp_cycles = true;
   const AuditResult null_r = run_null(base, d, timed_audit, part, o.verbose);
   std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
   for (const auto& cand : null_r.candidates) {

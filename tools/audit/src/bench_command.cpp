@@ -35,12 +35,15 @@ void bench_usage(std::FILE* f) {
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
+               "                       [--temp-follows-time]\n"
                "writes one simulated campaign, optionally with catalogue effects (--effect\n"
                "repeated; a firmware campaign lasts as long as its table turn; --duration is\n"
                "ignored),\n"
                "1/f noise, one effect outside the catalogue (gain_ratio_drift 1/h,\n"
                "phase_drift rad/h, offset_x V, gain_ratio_vs_temperature 1/degC) and a\n"
-               "reference that follows the resonance (f_ref_hz per row).\n");
+               "reference that follows the resonance (f_ref_hz per row). The temperature swings\n"
+               "through two cycles with its line in time taken out, as in the benchmark;\n"
+               "--temp-follows-time: one slow sine of 1.3 run lengths instead.\n");
 }
 
 bool parse_design(std::string_view name, bench::Design& d) {
@@ -82,6 +85,7 @@ struct BenchArgs {
   std::vector<std::pair<std::string, double>> effects;  // --effect ID VALUE, repeatable
   double duration_s = 480.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
   bool pll = false;
+  bool temp_follows_time = false;
 };
 
 // Reads the option at args[i] (and its values); false with a message when
@@ -118,6 +122,8 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
     b.outside_value = std::atof(args[++i]);
   } else if (a == "--pll") {
     b.pll = true;
+  } else if (a == "--temp-follows-time") {
+    b.temp_follows_time = true;
   } else if (a == "--verbose") {
     b.o.verbose = true;
   } else {
@@ -147,6 +153,7 @@ int emit_recording(const BenchArgs& b) {
   if (b.noise_v >= 0.0) sc.noise_v = b.noise_v;
   sc.flicker_corner_hz = b.flicker_hz;
   sc.pll_reference = b.pll;
+  sc.temp_cycles = !b.temp_follows_time;
   if (!b.outside.empty() && !bench::outside_by_name(b.outside, sc.outside)) {
     std::fprintf(stderr, "hrg audit-bench: unknown --outside shape '%s'\n", b.outside.c_str());
     return 2;

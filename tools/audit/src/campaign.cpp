@@ -79,6 +79,31 @@ void restrict_to_firmware(Scenario& s, std::mt19937_64& g) {
 
 }  // namespace
 
+sim::Profile temperature_profile(const Scenario& s, double phase_rad) {
+  if (!s.temp_cycles) {
+    return sim::Profile::sine(s.temp_swing_c, 1.0 / (1.3 * s.duration_s), phase_rad)
+        .add_offset(s.temp_mean_c);
+  }
+  // h(u) = sin(4 pi u + phase) minus its least-squares line over u in [0, 1]:
+  // the line's slope is 12 int (u - 1/2) h du, its offset the mean of h (0
+  // over two whole cycles).
+  const double slope = -12.0 * std::cos(phase_rad) / (4.0 * kPi);
+  constexpr int kPoints = 256;
+  std::vector<sim::ProfilePoint> pts;
+  std::vector<double> h(kPoints + 1);
+  double peak = 0.0;
+  for (int i = 0; i <= kPoints; ++i) {
+    const double u = static_cast<double>(i) / kPoints;
+    h[static_cast<std::size_t>(i)] = std::sin(4.0 * kPi * u + phase_rad) - slope * (u - 0.5);
+    peak = std::max(peak, std::abs(h[static_cast<std::size_t>(i)]));
+  }
+  for (int i = 0; i <= kPoints; ++i) {
+    pts.push_back({s.duration_s * static_cast<double>(i) / kPoints,
+                   s.temp_mean_c + s.temp_swing_c * h[static_cast<std::size_t>(i)] / peak});
+  }
+  return sim::Profile::ramps(std::move(pts));
+}
+
 Scenario random_scenario(Design design, double duration_s, uint64_t seed) {
   std::mt19937_64 g(seed * 7919ULL + 17ULL);
   Scenario s;
@@ -126,10 +151,8 @@ recording::Recording simulate_averaged(const Scenario& s) {
   std::normal_distribution<double> noise(0.0, s.noise_v);
   const auto segs = plan(s, g);
   sim::AveragedModel m(s.resonator, s.electrodes, s.effects, s.f_ref_hz);
-  // Slow temperature swing over the campaign, with a random phase.
-  m.set_temperature_profile(
-      sim::Profile::sine(s.temp_swing_c, 1.0 / (1.3 * s.duration_s), uniform(g, 0.0, 2.0 * kPi))
-          .add_offset(s.temp_mean_c));
+  // The temperature over the campaign, with a random phase.
+  m.set_temperature_profile(temperature_profile(s, uniform(g, 0.0, 2.0 * kPi)));
   // Rate steps exactly at the sample where their segment starts.
   const double dt = 1.0 / s.sample_rate_hz;
   std::vector<sim::ProfilePoint> rate_points;

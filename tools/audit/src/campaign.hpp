@@ -22,6 +22,7 @@
 #include "audit/bench.hpp"
 #include "recording/recording.hpp"
 #include "sim_target/params.hpp"
+#include "sim_target/profile.hpp"
 
 namespace hrg::audit::bench {
 
@@ -49,6 +50,7 @@ struct Scenario {
   double sample_rate_hz = 200.0;
   double temp_mean_c = 25.0, temp_swing_c = 1.0;  // slow temperature swing
   double temp_phase_rad = 0.0;
+  bool temp_cycles = false;  // see temperature_profile()
   // Beyond sim_target, applied to the recorded signals (outside_effects.cpp):
   // 1/f-like noise on each demodulated signal, its spectral density equal to
   // the white noise's at this corner (0: white noise only); one effect the
@@ -63,6 +65,13 @@ struct Scenario {
   double sweep_rate_dps = 10.0;  // case rate of the table's turn
   uint64_t seed = 1;
 };
+
+// The campaign's temperature about s.temp_mean_c with a swing of
+// s.temp_swing_c and phase `phase_rad`: a sine of 1.3 run lengths (it
+// follows time over the run), or with s.temp_cycles two cycles over the run
+// with their straight line in time taken out, so that a thermal effect and
+// a drift in time predict different things (uncorrelated with time).
+sim::Profile temperature_profile(const Scenario& s, double phase_rad);
 
 // A random resonator, noise and campaign of the given design (effects off).
 Scenario random_scenario(Design design, double duration_s, uint64_t seed);

@@ -52,8 +52,7 @@ sim_run::RunConfig firmware_job(const Scenario& s) {
   const double adc_noise_v = s.noise_v * std::sqrt(0.5 * static_cast<double>(c.adc.block_frames));
   c.adc.noise_v_rms = {adc_noise_v, adc_noise_v};
   c.rate_rad_s = sweep_profile(s, j.earth_rate_rad_s);
-  c.temp_c = sim::Profile::sine(s.temp_swing_c, 1.0 / (1.3 * s.duration_s), s.temp_phase_rad)
-                 .add_offset(s.temp_mean_c);
+  c.temp_c = temperature_profile(s, s.temp_phase_rad);
   j.sweep_end_s = j.duration_s;
   fw::GyroConfig& g = j.firmware.gyro;
   g.amplitude_set_v = s.amplitude_v;

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
 
 #include <Eigen/Dense>
 
@@ -35,6 +38,8 @@ LagSums lag_sums(const Dataset& d, const std::vector<double>& res, std::size_t c
   return s;
 }
 
+void fit_scale_var(const Dataset& d, const std::vector<double>& res, ArNoise& ar);
+
 }  // namespace
 
 ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res) {
@@ -66,26 +71,121 @@ ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res) {
     all.resize(best + 1);
     ar.orders[c] = std::move(all);
   }
+  fit_scale_var(d, res, ar);
   return ar;
 }
 
-double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArNoise& ar) {
-  double chi2 = 0.0;
+namespace {
+
+// The whitened residuals of one channel of one free segment (blocks from
+// residual index k0): each block's prediction error over its innovation sd,
+// the first blocks predicted with the lags they have.
+void innovations(const std::vector<double>& res, std::size_t k0, std::size_t n_blocks,
+                 std::size_t c, const ArNoise& ar, std::vector<double>& e) {
+  e.resize(n_blocks);
+  for (std::size_t b = 0; b < n_blocks; ++b) {
+    const double r = res[k0 + 4 * b + c];
+    if (ar.orders[c].empty()) {
+      e[b] = r;
+      continue;
+    }
+    const auto& o = ar.orders[c][std::min<std::size_t>(b, ar.orders[c].size() - 1)];
+    double v = r;
+    for (std::size_t l = 1; l <= o.coef.size(); ++l)
+      v -= o.coef[l - 1] * res[k0 + 4 * (b - l) + c];
+    e[b] = v / std::sqrt(o.var);
+  }
+}
+
+// Orthonormal Haar transform of `a` (overwritten): f(scale, c^2, detail) for
+// every coefficient, the details of scale j (differences of the means of
+// 2^(j-1) blocks), the unpaired remainders and the last mean at the scale
+// above the level they stand for. The squares add up to sum a^2.
+template <class F>
+void haar(std::vector<double>& a, F&& f) {
+  constexpr double kR = std::numbers::sqrt2 / 2.0;
+  int level = 0;
+  while (a.size() > 1) {
+    const int scale = std::min(level + 1, ArNoise::kScales);
+    if (a.size() % 2 == 1) f(scale, a.back() * a.back(), false);
+    const std::size_t m = a.size() / 2;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double dk = kR * (a[2 * k] - a[2 * k + 1]);
+      a[k] = kR * (a[2 * k] + a[2 * k + 1]);
+      f(scale, dk * dk, true);
+    }
+    a.resize(m);
+    ++level;
+  }
+  if (!a.empty()) f(std::min(level + 1, ArNoise::kScales), a[0] * a[0], false);
+}
+
+// Least Haar details of a scale for its variance to be estimated.
+constexpr double kMinScaleCount = 16.0;
+
+// Variance of the whitened residuals' Haar details per pickoff and scale,
+// kept where it stands 3 standard errors above the white level 1; a scale
+// with too few details takes the one below it.
+void fit_scale_var(const Dataset& d, const std::vector<double>& res, ArNoise& ar) {
+  std::array<std::array<double, ArNoise::kScales + 1>, 2> sum{}, cnt{};
+  std::vector<double> e;
   std::size_t k0 = 0;
   for (const auto& seg : d.free) {
-    for (std::size_t b = 0; b < seg.n_blocks; ++b) {
-      for (std::size_t c = 0; c < 4; ++c) {
-        const double r = res[k0 + 4 * b + c];
-        if (ar.orders[c].empty()) {
-          chi2 += r * r;
-          continue;
-        }
-        const auto& o = ar.orders[c][std::min<std::size_t>(b, ar.orders[c].size() - 1)];
-        double e = r;
-        for (std::size_t l = 1; l <= o.coef.size(); ++l)
-          e -= o.coef[l - 1] * res[k0 + 4 * (b - l) + c];
-        chi2 += e * e / o.var;
-      }
+    for (std::size_t c = 0; c < 4; ++c) {
+      innovations(res, k0, seg.n_blocks, c, ar, e);
+      haar(e, [&](int j, double c2, bool detail) {
+        if (!detail) return;
+        sum[c / 2][static_cast<std::size_t>(j)] += c2;
+        cnt[c / 2][static_cast<std::size_t>(j)] += 1.0;
+      });
+    }
+    k0 += 4 * seg.n_blocks;
+  }
+  for (std::size_t p = 0; p < 2; ++p) {
+    auto& lambda = ar.scale_var[p];
+    std::size_t first = 0, last = 0;  // last estimated scale, first of the run above 1 up to it
+    for (std::size_t j = 1; j <= ArNoise::kScales && cnt[p][j] >= kMinScaleCount; ++j) {
+      const double v = sum[p][j] / cnt[p][j];
+      lambda[j] = v > 1.0 + 3.0 * std::sqrt(2.0 / cnt[p][j]) ? v : 1.0;
+      if (lambda[j] == 1.0) first = 0;
+      if (lambda[j] > 1.0 && first == 0) first = j;
+      last = j;
+    }
+    // Coarser scales have too few details to be estimated: the variance
+    // grows on as it grew from the white level over the run of scales above
+    // it up to the last estimated one (at most 2x per scale, 1/f noise's law
+    // for Haar details); one scale above the white level alone (3 standard
+    // errors of chance among a dozen scales) is carried on, not grown.
+    const bool run = first != 0 && last > first;
+    const double growth =
+        run ? std::clamp(std::pow(lambda[last], 1.0 / static_cast<double>(last - first + 1)), 1.0,
+                         2.0)
+            : 1.0;
+    for (std::size_t j = last + 1; j <= ArNoise::kScales; ++j)
+      lambda[j] = lambda[j - 1] * growth;
+  }
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    for (std::size_t p = 0; p < 2; ++p) {
+      std::fprintf(stderr, "scales p%zu:", p);
+      for (std::size_t j = 1; j <= ArNoise::kScales; ++j)
+        std::fprintf(stderr, " %.2f(%.0f,%.2f)", ar.scale_var[p][j], cnt[p][j],
+                     cnt[p][j] > 0 ? sum[p][j] / cnt[p][j] : 0.0);
+      std::fprintf(stderr, "\n");
+    }
+  }
+}
+
+}  // namespace
+
+double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArNoise& ar) {
+  double chi2 = 0.0;
+  std::vector<double> e;
+  std::size_t k0 = 0;
+  for (const auto& seg : d.free) {
+    for (std::size_t c = 0; c < 4; ++c) {
+      innovations(res, k0, seg.n_blocks, c, ar, e);
+      const auto& lambda = ar.scale_var[c / 2];
+      haar(e, [&](int j, double c2, bool) { chi2 += c2 / lambda[static_cast<std::size_t>(j)]; });
     }
     k0 += 4 * seg.n_blocks;
   }

@@ -6,6 +6,11 @@
 // per block), its order chosen by BIC, fitted to the residuals of the model a
 // test accepts. Coloured noise (1/f-like on the demodulated signals) is then
 // whitened before chi^2 is counted, so slow noise is not taken for structure.
+// Noise slower than an AR model of a few lags follows (the slowest octaves of
+// 1/f noise, correlated over hundreds of blocks) is held by the variance of
+// the whitened residuals at dyadic scales (orthonormal Haar coefficients per
+// segment, which decorrelate 1/f-like noise): each scale's chi^2 is counted
+// against its own variance where that stands significantly above 1.
 
 #include <array>
 #include <vector>
@@ -24,6 +29,15 @@ struct ArNoise {
     double var = 1.0;
   };
   std::array<std::vector<Order>, 4> orders;
+  // Variance of the whitened residuals' Haar coefficients per pickoff (x:
+  // channels 0-1, y: 2-3) and scale (1 = pairs of blocks, j = 2^j blocks),
+  // over the white level 1; 1 where not significantly above it.
+  static constexpr int kScales = 16;
+  std::array<std::array<double, kScales + 1>, 2> scale_var{};
+  ArNoise() {
+    for (auto& v : scale_var)
+      v.fill(1.0);
+  }
   int order(std::size_t channel) const {
     return orders[channel].empty() ? 0 : static_cast<int>(orders[channel].size()) - 1;
   }
