@@ -46,6 +46,23 @@ uint32_t WindowScheduler::least_covered_bin() const {
   return best;
 }
 
+double WindowScheduler::nearest_least_covered_rad(double theta_rad) const {
+  // The pattern walks bin by bin instead of crossing the circle (the forcers
+  // turn it slowly).
+  const uint32_t least = counts_[least_covered_bin()];
+  double best_dist = 1e300;
+  double best = theta_rad;
+  for (uint32_t b = 0; b < cfg_.bins; ++b) {
+    if (counts_[b] != least) continue;
+    const double target = bin_centre_near(b, theta_rad);
+    if (std::fabs(target - theta_rad) < best_dist) {
+      best_dist = std::fabs(target - theta_rad);
+      best = target;
+    }
+  }
+  return best;
+}
+
 double WindowScheduler::excitation_off_fraction() const {
   return frames_ == 0 ? 0.0 : static_cast<double>(off_frames_) / static_cast<double>(frames_);
 }
@@ -58,6 +75,28 @@ void WindowScheduler::open(uint32_t bin, uint32_t length_frames, WindowDecision&
   window_bin_ = bin;
   since_start_ = 0;
   moving_ = false;
+  move_frames_ = 0;
+}
+
+void WindowScheduler::operation_window(double theta_rad, bool is_static, uint32_t length_frames,
+                                       WindowDecision& d) {
+  const uint32_t bin = bin_of(theta_rad);
+  // Once started, the walk holds its target (the pattern's own motion must
+  // not make the base look turning) until the pattern reaches a least-covered
+  // bin or the longest wait has passed.
+  const bool walk = cfg_.rotate_in_operation && (moving_ || is_static) && !under_covered(bin) &&
+                    move_frames_ < cfg_.max_walk_frames;
+  if (!walk) {
+    open(bin, length_frames, d);
+    return;
+  }
+  if (!moving_) {
+    move_target_rad_ = nearest_least_covered_rad(theta_rad);
+    moving_ = true;
+  }
+  ++move_frames_;
+  d.pattern_command = true;
+  d.pattern_target_rad = move_target_rad_;
 }
 
 uint32_t WindowScheduler::operation_window_due(bool is_static) const {
@@ -125,8 +164,11 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
       static_frames_ = is_static ? static_frames_ + 1 : 0;
       const uint32_t length = mode == Mode::operate ? operation_window_due(is_static) : 0;
       if (length != 0) {
-        open(bin_of(theta_rad), length, d);
-        static_checked_ = static_checked_ || is_static;
+        operation_window(theta_rad, is_static, length, d);
+        static_checked_ = static_checked_ || (d.open && is_static);
+      } else {
+        moving_ = false;  // nothing due (or not operating): no walk under way
+        move_frames_ = 0;
       }
       return d;
     }
@@ -146,20 +188,10 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
       return d;
     }
     if (!moving_ && is_static && cfg_.rotate_on_static_base) {
-      // The nearest of the least-covered bins: the pattern walks bin by bin
-      // instead of crossing the circle (the forcers turn it slowly). Once
-      // started, the move holds its target until a window opens (the
-      // pattern's own motion must not make the base look turning).
-      const uint32_t least = counts_[least_covered_bin()];
-      double best_dist = 1e300;
-      for (uint32_t b = 0; b < cfg_.bins; ++b) {
-        if (counts_[b] != least) continue;
-        const double target = bin_centre_near(b, theta_rad);
-        if (std::fabs(target - theta_rad) < best_dist) {
-          best_dist = std::fabs(target - theta_rad);
-          move_target_rad_ = target;
-        }
-      }
+      // The nearest of the least-covered bins. Once started, the move holds
+      // its target until a window opens (the pattern's own motion must not
+      // make the base look turning).
+      move_target_rad_ = nearest_least_covered_rad(theta_rad);
       moving_ = true;
     }
   }

@@ -8,7 +8,8 @@
 // prediction of it for the windows taken (sqrt of the bound's dnu_C, dnu_S
 // variances over K). At the end, the parked-angle test's figures.
 //
-//   bench_sim_day [--hours H] [--thermal] [--forgetting-s S] [--duty D] [--window-s S]
+//   bench_sim_day [--hours H] [--thermal] [--period-h P] [--coefficient]
+//                 [--adaptive-memory] [--rotate] [--forgetting-s S] [--duty D] [--window-s S]
 //                 [--csv FILE]
 //
 // --csv: the hourly figures as CSV (default bench_sim_day.csv in the working
@@ -16,9 +17,21 @@
 // its bound at 1, 3, 6, 12 and 24 h again, with the bound's fall against
 // 1/sqrt(T) and the ADB's.
 // --window-s: length of the operation windows (default the plan's, 30 s).
-// --thermal: the resonator's damping changes by 0.2 %/degC (thermal_damping)
-// under a +-2 degC sine with one period over the run. About 180 simulated s
-// per CPU s: a 24 h run takes ~8 CPU minutes (run it under nice).
+// --thermal: the thermal day. The resonator's frequency changes by 5 ppm/degC
+// (thermal_frequency) and its damping by 0.4 %/degC (thermal_damping) under a
+// +-2 degC sine of period --period-h (default one period over the run).
+// --coefficient: the calibration carries both thermal coefficients (as the
+// audit fits them), so the firmware refers its damping regressors and the
+// drift to the temperature its sensor reads. --adaptive-memory: the
+// estimator derives its memory from the parameters' seen motion
+// (est::Estimator::Config::forgetting). --rotate: the operation windows walk
+// the pattern to the least-covered 4 theta bin first
+// (WindowConfig::rotate_in_operation); the run's held-output share and the
+// windows per bin are printed. The model ADB is that of the
+// correction in force: the identified anisotropy times the firmware's known
+// damping factor now, against the truth at the resonator's temperature now.
+// About 180 simulated s per CPU s: a 24 h run takes ~8 CPU minutes (run it
+// under nice).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -39,6 +52,10 @@ constexpr double kRadSToDph = 180.0 / std::numbers::pi * 3600.0;
 struct Options {
   double hours = 24.0;
   bool thermal = false;
+  double period_h = 0.0;      // thermal swing's period (0: the run's length)
+  bool coefficient = false;   // the calibration's thermal coefficients in force
+  bool adaptive = false;      // memory derived from the parameters' motion
+  bool rotate = false;        // operation windows walk the pattern to other angles
   double forgetting_s = 0.0;  // 0: derived by the estimator
   double duty = fw::app::kDefaultOperationDuty;
   double window_s = 0.0;  // operation windows' length (0: the plan's)
@@ -61,6 +78,14 @@ bool parse(int argc, char** argv, Options& o) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--thermal") == 0) {
       o.thermal = true;
+    } else if (std::strcmp(argv[i], "--coefficient") == 0) {
+      o.coefficient = true;
+    } else if (std::strcmp(argv[i], "--adaptive-memory") == 0) {
+      o.adaptive = true;
+    } else if (std::strcmp(argv[i], "--rotate") == 0) {
+      o.rotate = true;
+    } else if (std::strcmp(argv[i], "--period-h") == 0 && has_value) {
+      o.period_h = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--hours") == 0 && has_value) {
       o.hours = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--forgetting-s") == 0 && has_value) {
@@ -73,12 +98,20 @@ bool parse(int argc, char** argv, Options& o) {
       o.csv = argv[++i];
     } else {
       std::fprintf(stderr,
-                   "usage: bench_sim_day [--hours H] [--thermal] [--forgetting-s S] "
-                   "[--duty D] [--window-s S] [--csv FILE]\n");
+                   "usage: bench_sim_day [--hours H] [--thermal] [--period-h P] "
+                   "[--coefficient] [--adaptive-memory] [--rotate] [--forgetting-s S] [--duty D] "
+                   "[--window-s S] [--csv FILE]\n");
       return false;
     }
   }
-  return o.hours > 0.0 && o.duty > 0.0 && o.duty < 1.0;
+  if (!(o.hours > 0.0 && o.duty > 0.0 && o.duty < 1.0 && o.period_h >= 0.0)) {
+    std::fprintf(stderr,
+                 "bench_sim_day: --hours must be > 0, --duty in (0, 1), --period-h >= 0 "
+                 "(got %g, %g, %g)\n",
+                 o.hours, o.duty, o.period_h);
+    return false;
+  }
+  return true;
 }
 
 // The model's angle-dependent bias error and its Cramer-Rao prediction (deg/h).
@@ -92,6 +125,9 @@ Hour observe(const fw::app::Firmware& f, const sim::SimTarget& target,
   const double scale =
       fx.enabled ? 1.0 + fx.rel_per_c * (target.true_state().temp_c - job.sim.resonator.temp_ref_c)
                  : 1.0;
+  // The factor the firmware applies to its model now (1 without a thermal
+  // coefficient; no nonlinear damping in this run, so the energy is moot).
+  const double fw_scale = f.estimator().damping_scale(0.0);
   Hour h;
   h.t_h = f.gyro().status().chain.t_s / 3600.0;
   h.off_pct = 100.0 * sched.excitation_off_fraction();
@@ -99,12 +135,57 @@ Hour observe(const fw::app::Firmware& f, const sim::SimTarget& target,
   h.memory_s = est.forgetting_time_s();
   h.temp_c = target.true_state().temp_c;
   if (est.has_model()) {
-    h.adb_dph = std::hypot(est.model()(1) - scale * truth[1], est.model()(2) - scale * truth[2]) /
+    h.adb_dph = std::hypot(fw_scale * est.model()(1) - scale * truth[1],
+                           fw_scale * est.model()(2) - scale * truth[2]) /
                 k * kRadSToDph;
     const est::ParamMatrix c = est.cramer_rao_bound(noise_sigma_v);
-    h.crb_dph = std::sqrt(std::max(c(1, 1) + c(2, 2), 0.0)) / k * kRadSToDph;
+    h.crb_dph = fw_scale * std::sqrt(std::max(c(1, 1) + c(2, 2), 0.0)) / k * kRadSToDph;
   }
   return h;
+}
+
+// Thermal coefficients of the thermal day (the Gregory table's rows).
+constexpr double kThermalFrequencyPpmPerC = 5.0;
+constexpr double kThermalDampingPerC = 0.004;
+constexpr double kSwingC = 2.0;
+
+void set_thermal_day(const Options& o, sim_run::RunConfig& job) {
+  auto& fx = job.sim.effects;
+  fx.thermal_frequency.enabled = true;
+  fx.thermal_frequency.ppm_per_c = kThermalFrequencyPpmPerC;
+  fx.thermal_damping.enabled = true;
+  fx.thermal_damping.rel_per_c = kThermalDampingPerC;
+  const double period_s = o.period_h > 0.0 ? o.period_h * 3600.0 : job.duration_s;
+  job.sim.temp_c = sim::Profile::sine(kSwingC, 1.0 / period_s, 0.0);
+  job.sim.temp_c.add_offset(job.sim.resonator.temp_ref_c);
+  if (!o.coefficient) return;
+  job.firmware.calibration.thermal_frequency_ppm_per_c = kThermalFrequencyPpmPerC;
+  job.firmware.calibration.thermal_damping_per_c = kThermalDampingPerC;
+  job.firmware.calibration.temperature_ref_c = job.sim.resonator.temp_ref_c;
+}
+
+std::vector<uint32_t> windows_per_bin(const fw::WindowScheduler& s) {
+  std::vector<uint32_t> n;
+  for (uint32_t b = 0; b < s.config().bins; ++b)
+    n.push_back(s.bin_count(b));
+  return n;
+}
+
+// The windows per 4 theta bin at the last hour (campaign included) and the
+// share of the run after the campaign with the output held by a pattern move.
+void print_angle_diversity(const std::vector<uint32_t>& bins, const sim_run::RunResult& r) {
+  std::printf("windows per 4 theta bin at the last hour:");
+  for (uint32_t n : bins)
+    std::printf(" %u", n);
+  std::size_t rows = 0, held = 0;
+  for (const auto& row : r.rows) {
+    if (row.t_s < r.t_operate_s) continue;
+    ++rows;
+    held += row.pattern_cmd ? 1 : 0;
+  }
+  std::printf("\noutput held by pattern moves: %.2f %% of the rows after %.0f s\n",
+              rows > 0 ? 100.0 * static_cast<double>(held) / static_cast<double>(rows) : 0.0,
+              r.t_operate_s);
 }
 
 double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
@@ -163,26 +244,32 @@ int main(int argc, char** argv) {
         static_cast<uint32_t>(std::lround(o.window_s * fw::kBaseRateHz));
   }
   job.firmware.estimator.ls.forgetting_time_s = o.forgetting_s;
-  if (o.thermal) {
-    job.sim.effects.thermal_damping.enabled = true;
-    job.sim.effects.thermal_damping.rel_per_c = 0.002;
-    job.sim.temp_c = sim::Profile::sine(2.0, 1.0 / job.duration_s, 0.0);
-    job.sim.temp_c.add_offset(job.sim.resonator.temp_ref_c);
-  }
+  job.firmware.estimator.forgetting.adaptive = o.adaptive;
+  job.firmware.gyro.windows.rotate_in_operation = o.rotate;
+  if (o.thermal) set_thermal_day(o, job);
   sim_run::derive_firmware_config(job);
   const double adc_sigma_v = job.sim.adc.noise_v_rms[0];
   const double noise_sigma_v =
       adc_sigma_v * std::sqrt(2.0 / static_cast<double>(job.firmware.chain.block_frames));
-  std::printf("%.1f h of the default scenario%s, operation duty %.1f %%, memory %s:\n", o.hours,
-              o.thermal ? " with thermal damping 0.2 %/degC under a +-2 degC swing" : "",
-              100.0 * o.duty, o.forgetting_s > 0 ? "set" : "derived");
+  std::printf("%.1f h of the default scenario", o.hours);
+  if (o.thermal) {
+    std::printf(
+        " with thermal frequency %.0f ppm/degC and damping %.1f %%/degC under a +-%.0f degC "
+        "sine of period %.1f h, thermal coefficients %s",
+        kThermalFrequencyPpmPerC, 100.0 * kThermalDampingPerC, kSwingC,
+        o.period_h > 0.0 ? o.period_h : o.hours, o.coefficient ? "in force" : "not known");
+  }
+  std::printf(", operation duty %.1f %%, memory %s:\n", 100.0 * o.duty,
+              o.forgetting_s > 0 ? "set" : (o.adaptive ? "derived" : "none (no forgetting)"));
   sim_run::RunOptions opt;
   opt.observe_every_s = 3600.0;
   std::vector<Hour> hours;
   hours.reserve(static_cast<std::size_t>(o.hours) + 1);
+  std::vector<uint32_t> bin_counts;
   opt.observer = [&](const fw::app::Firmware& f, const sim::SimTarget& t) {
     hours.push_back(observe(f, t, job, noise_sigma_v));
     print_hour(hours.back());
+    bin_counts = windows_per_bin(f.gyro().scheduler());
   };
   sim_run::RunResult r = sim_run::run_simulation(job, opt);
   const bool passed = sim_run::judge(job, r);
@@ -193,6 +280,9 @@ int main(int argc, char** argv) {
                 p.bias_model_dph, p.model_valid ? "" : "  (model not valid)");
   }
   std::printf("control-loop drift added: mean %+.4f deg/h\n", r.control_drift_mean_dph);
+  print_angle_diversity(bin_counts, r);
+  if (r.fit_comp.degenerate())
+    std::printf("parked-angle test: %s\n", sim_run::degenerate_parks_note(r.fit_comp).c_str());
   const bool written = write_csv(o.csv, hours);
   std::printf(
       "parked-angle test (%zu parks, %zu with the model valid): raw ADB %.3f, compensated "

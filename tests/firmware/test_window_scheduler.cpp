@@ -3,7 +3,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
+#include <array>
 #include <numbers>
+#include <vector>
 
 #include "support/cpputest.hpp"
 
@@ -322,4 +325,87 @@ TEST(WindowScheduler, ChecksKeepTheirLengthWhileTheDutysWindowsAreLong) {
   CHECK(static_cast<double>(long_windows) >=
         ((c.operation_duty - 10.0 / 500.0) * frames - campaign_off) / 100.0 - 1.0);
   CHECK(static_cast<double>(long_windows) <= c.operation_duty * frames / 100.0);
+}
+
+namespace {
+// A still base whose pattern drifts back to one equilibrium angle between
+// windows (at a tenth of the walk's rate) and follows a pattern command at
+// the forcers' rate.
+struct StillPattern {
+  double theta_rad;
+  double equilibrium_rad;
+  double walk_rad_per_frame;
+  void step(const WindowDecision& d) {
+    const double target = d.pattern_command ? d.pattern_target_rad : equilibrium_rad;
+    const double rate = d.pattern_command ? walk_rad_per_frame : 0.1 * walk_rad_per_frame;
+    const double e = target - theta_rad;
+    theta_rad += std::fabs(e) <= rate ? e : std::copysign(rate, e);
+  }
+};
+
+struct StillRun {
+  std::vector<uint32_t> bins;     // bin of each operation window
+  std::array<uint32_t, 8> total;  // the scheduler's count per bin, campaign included
+  uint32_t walk_frames = 0;
+  uint32_t longest_walk_frames = 0;
+};
+
+// The operation windows of a still run after a campaign on a turning table.
+StillRun still_run(bool rotate) {
+  WindowConfig c = small_config();  // 8 bins
+  c.operation_duty = 0.05;
+  c.rotate_in_operation = rotate;
+  c.max_walk_frames = 2000;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  for (int f = 0; f < 400; ++f)
+    l.frame(0.05 * f, 2.0, good);
+  CHECK(l.s.campaign_done());
+  // 0.1 deg of pattern angle per frame: an 11.25 deg bin in ~113 frames
+  StillPattern p{0.3, 0.3, 0.1 * kPi / 180.0};
+  StillRun r;
+  uint32_t walk = 0;
+  for (int f = 0; f < 60000; ++f) {
+    const WindowDecision d = l.frame(p.theta_rad, 0.0, good);
+    if (d.open) r.bins.push_back(l.s.bin_of(p.theta_rad));
+    walk = d.pattern_command ? walk + 1 : 0;
+    r.walk_frames += d.pattern_command ? 1 : 0;
+    r.longest_walk_frames = std::max(r.longest_walk_frames, walk);
+    p.step(d);
+  }
+  for (uint32_t b = 0; b < 8; ++b)
+    r.total[b] = l.s.bin_count(b);
+  return r;
+}
+}  // namespace
+
+TEST(WindowScheduler, WithoutRotationTheOperationWindowsOfAStillRunSeeOneAngle) {
+  const StillRun r = still_run(false);
+  CHECK(r.bins.size() > 100);  // 5 % of 60000 frames in 10-frame windows: ~300
+  for (uint32_t b : r.bins)
+    LONGS_EQUAL(r.bins.front(), b);  // the equilibrium's bin, every time
+  LONGS_EQUAL(0, r.walk_frames);
+}
+
+TEST(WindowScheduler, RotationInOperationSpreadsTheWindowsOverEveryBinEvenly) {
+  // GIVEN a still run whose pattern returns to one angle between windows
+  const StillRun r = still_run(true);
+  CHECK(r.bins.size() > 100);
+  // THEN the windows fill the 8 bins in turn: with the campaign's, every bin
+  // holds the same count within one window, and the operation windows alone
+  // at least their even share less the most the campaign put in one bin
+  const auto [lo, hi] = std::minmax_element(r.total.begin(), r.total.end());
+  CHECK(*hi - *lo <= 1);
+  std::array<uint32_t, 8> ops{};
+  for (uint32_t b : r.bins)
+    ++ops[b];
+  uint32_t campaign_max = 0;
+  for (uint32_t b = 0; b < 8; ++b)
+    campaign_max = std::max(campaign_max, r.total[b] - ops[b]);
+  for (uint32_t b = 0; b < 8; ++b)
+    CHECK(ops[b] + campaign_max >= r.bins.size() / 8);
+  // and each walk is no longer than the farthest bin of a half circle takes
+  // at the walk's rate (4 bins of 11.25 deg at 0.1 deg per frame: 450 frames)
+  CHECK(r.walk_frames > 0);
+  CHECK(r.longest_walk_frames <= 451);
 }

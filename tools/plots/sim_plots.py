@@ -86,6 +86,12 @@ def main(out):
             grid = [lo + (hi - lo) * i / 200 for i in range(201)]
             for key, style in (("raw", "-"), ("compensated", "-")):
                 d = rep["drift"][key]
+                if d.get("degenerate"):
+                    # parks at nearly one 4 theta: the fit's b and ADB are not separable
+                    ax.axhline(d["park_mean_dph"], ls="--", alpha=0.6,
+                               label=f"{key}: parks span {d['span_deg']:.1f} deg, "
+                                     f"mean {d['park_mean_dph']:.4f} deg/h (no ADB)")
+                    continue
                 ax.plot(grid, [d["mean_dph"] + d["sin4_dph"] * math.sin(4 * math.radians(g)) +
                                d["cos4_dph"] * math.cos(4 * math.radians(g)) for g in grid],
                         style, alpha=0.6,

@@ -42,6 +42,18 @@ struct WindowConfig {
   // windows want short checks (a 30 s check every 10 min alone is 5 %
   // excitation off); a long operation window is a check as well.
   uint32_t check_length_frames = 0;
+  // Angle diversity in operation: on a still base the pattern settles at its
+  // drift's equilibrium angle, so every operation window would see one
+  // 4 theta and inform only nu and one combination of the anisotropy terms.
+  // With this set, an operation window due while the pattern sits in a bin
+  // that holds more windows than the least-covered ones first walks the
+  // pattern to the nearest of those (the forcers turn it; the output is held
+  // while it moves, GyroStatus::pattern_control), or opens where it is after
+  // max_walk_frames of walking.
+  bool rotate_in_operation = false;
+  // Longest walk (base frames): 45 deg of pattern angle, the farthest bin of
+  // a half circle, at the default forcers' 0.36 deg/s is 125 s.
+  uint32_t max_walk_frames = 180000;
 };
 
 struct WindowDecision {
@@ -97,6 +109,11 @@ class WindowScheduler {
     return cfg_.check_length_frames != 0 ? cfg_.check_length_frames : operation_length();
   }
   uint32_t least_covered_bin() const;
+  // theta_A of the nearest centre of a least-covered bin.
+  double nearest_least_covered_rad(double theta_rad) const;
+  // The operation window due now (rotate_in_operation: after the walk).
+  void operation_window(double theta_rad, bool is_static, uint32_t length_frames,
+                        WindowDecision& d);
 
   WindowConfig cfg_;
   std::array<uint32_t, kMaxBins> counts_{};
@@ -114,6 +131,7 @@ class WindowScheduler {
   uint32_t static_frames_ = 0;   // frames the base has been still, after the campaign
   bool moving_ = false;          // a commanded pattern move is under way
   double move_target_rad_ = 0.0;
+  uint32_t move_frames_ = 0;  // frames of the operation walk under way
 };
 
 }  // namespace hrg::fw

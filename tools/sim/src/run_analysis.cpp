@@ -78,17 +78,28 @@ void parked_bias(RunResult& r, const RunConfig& job) {
     }
   }
   for (const ParkedInterval& p : job.parks) {
-    std::vector<double> t, eraw, ecomp;
+    std::vector<double> t, eraw, ecomp, eraw_held, ecomp_held;
     double model = 0, theta_sum = 0;
     bool valid = true;
+    bool moved = false;  // the firmware moved the pattern on purpose in the park
     for (const TelemetryRow& row : r.rows) {
-      if (row.t_s < p.t_begin_s || row.t_s > p.t_end_s || !row.out_valid) continue;
+      if (row.t_s < p.t_begin_s || row.t_s > p.t_end_s) continue;
+      moved = moved || row.pattern_cmd;
+      if (!row.out_valid) continue;
       valid = valid && row.comp_valid;
       t.push_back(row.t_s);
       eraw.push_back(row.raw_angle_deg - row.true_angle_deg);
       ecomp.push_back(row.out_angle_deg - row.true_angle_deg);
+      eraw_held.push_back(row.raw_error_deg);
+      ecomp_held.push_back(row.out_error_deg);
       theta_sum += row.theta_deg * kDeg;
       model += row.drift_true_dph;
+    }
+    // A move holds the output (the input turned meanwhile is not seen): the
+    // bias is the slope of the error accumulated over the valid rows only.
+    if (moved) {
+      eraw.swap(eraw_held);
+      ecomp.swap(ecomp_held);
     }
     if (t.size() < 10) continue;
     ParkResult pr;

@@ -43,6 +43,10 @@ void print_summary(std::FILE* out, const RunConfig& job, const RunResult& r);
 // throughout), since when, and the run length the resonator needs.
 std::string bias_test_coverage(const RunResult& r);
 
+// A parked-angle set too narrow for the 4 theta fit (BiasFit::degenerate):
+// the parks' angle span, the fit's condition and the mean bias over them.
+std::string degenerate_parks_note(const BiasFit& f);
+
 // Fills r.failures with what makes the run a failure (see the checks in
 // report_json); returns true when the run passed.
 bool judge(const RunConfig& job, RunResult& r);
