@@ -73,6 +73,17 @@ def plane_panels(points):
     return panels
 
 
+def compensated(point):
+    """Whether any seed of the point had its compensation applied (a compensated ADB exists)."""
+    return any(r.get("compensation_applied", True) for r in point.get("per_seed", [{}]))
+
+
+def masked(rows):
+    """The rows as an array with NaN masked (drawn in the colour map's 'bad' colour)."""
+    import numpy as np
+    return np.ma.masked_invalid(np.array(rows, dtype=float))
+
+
 def plot_plane(study, path, plt):
     panels = plane_panels(study["points"])
     n = len(panels)
@@ -82,25 +93,32 @@ def plot_plane(study, path, plt):
     for ax, ((gap, q), pts) in zip(axes.flat, sorted(panels.items())):
         splits = sorted({p["split_hz"] for p in pts})
         dqs = sorted({p["dq_over_q"] for p in pts})
+        # A point where no seed had its compensation applied has no compensated
+        # ADB: it stays blank (grey), never drawn as a low value.
         z = [[float("nan")] * len(splits) for _ in dqs]
         for p in pts:
-            z[dqs.index(p["dq_over_q"])][splits.index(p["split_hz"])] = max(p["comp_adb_dph"], 1e-4)
+            if compensated(p):
+                z[dqs.index(p["dq_over_q"])][splits.index(p["split_hz"])] = max(p["comp_adb_dph"], 1e-4)
         logz = [[math.log10(v) for v in r] for r in z]
-        im = ax.pcolormesh(range(len(splits) + 1), range(len(dqs) + 1), logz, cmap="viridis",
+        cmap = plt.get_cmap("viridis").copy()
+        cmap.set_bad("0.8")
+        im = ax.pcolormesh(range(len(splits) + 1), range(len(dqs) + 1), masked(logz), cmap=cmap,
                            shading="flat")
-        if len(splits) > 1 and len(dqs) > 1:
+        seen = [v for r in logz for v in r if not math.isnan(v)]
+        if len(splits) > 1 and len(dqs) > 1 and seen:
             xs = [i + 0.5 for i in range(len(splits))]
             ys = [j + 0.5 for j in range(len(dqs))]
-            lo, hi = min(map(min, logz)), max(map(max, logz))
+            lo, hi = min(seen), max(seen)
             if lo < math.log10(3.0) < hi:
-                cs = ax.contour(xs, ys, logz, levels=[math.log10(3.0)], colors="white",
+                cs = ax.contour(xs, ys, masked(logz), levels=[math.log10(3.0)], colors="white",
                                 linewidths=2)
                 ax.clabel(cs, fmt={math.log10(3.0): "3 deg/h"}, fontsize=8)
         for p in pts:
             i, j = splits.index(p["split_hz"]), dqs.index(p["dq_over_q"])
             mark = "" if p["meets_bound"] else "\n(misses: see reasons)"
-            ax.text(i + 0.5, j + 0.5, "%.3g%s" % (p["comp_adb_dph"], mark), ha="center",
-                    va="center", fontsize=7, color="white" if logz[j][i] < 1 else "black")
+            text = "%.3g%s" % (p["comp_adb_dph"], mark) if compensated(p) else "no valid\ncompensation"
+            ax.text(i + 0.5, j + 0.5, text, ha="center", va="center", fontsize=7,
+                    color="white" if logz[j][i] < 1 else "black")
         ax.set_xticks([i + 0.5 for i in range(len(splits))], ["%.0e" % s for s in splits])
         ax.set_yticks([j + 0.5 for j in range(len(dqs))], ["%.3g" % d for d in dqs])
         ax.set_xlabel("split, Hz")
