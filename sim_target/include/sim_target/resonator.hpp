@@ -106,7 +106,7 @@ class Resonator {
       return;
     }
     const HeldCoefficients c = prepare_held(rate, temp_c, dt_s);
-    if (c.iso == 0.0 && c.damp == 0.0 && !pickoff_effects_) {
+    if (kPlainMatchesEigen && c.iso == 0.0 && c.damp == 0.0 && !pickoff_effects_) {
       step_plain(drives, n, sink);
       cursor_steps_ = steps_ - 1;
       return;
@@ -172,6 +172,11 @@ class Resonator {
     next += c_gap * terms.tail<4>();
     return next;
   }
+  // step_plain() follows the order of Eigen's packet product on two doubles.
+  // Where Eigen does not vectorise doubles in pairs (armhf: no double SIMD),
+  // its scalar product sums as a tree, so the general loop is taken instead.
+  static constexpr bool kPlainMatchesEigen = Eigen::internal::packet_traits<double>::Vectorizable &&
+                                             Eigen::internal::packet_traits<double>::size == 2;
   // step_block's held-inputs loop when no stiffness, damping or pickoff term
   // is on: propagate() written out on pairs of rows, the same operations in
   // the same order (Eigen's sums column by column: ((c0 u0 + c1 u1) + c2 u2)
