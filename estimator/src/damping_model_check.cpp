@@ -48,7 +48,7 @@ Status DampingModelCheck::add_sample(const WaveSample& s) {
   }
   if (samples_in_window_ > 0 && !(s.t_s > last_t_)) return Status::time_not_increasing;
   // r = R/E, s = S/E (dsp/wave_variables.hpp).
-  const double p_over_e = (s.a_A_v * s.a_A_v - s.a_B_v * s.a_B_v) / s.E_v2;
+  const double p_over_e = s.p_over_e();
   const double r = p_over_e * std::cos(4.0 * s.theta_A_rad);
   const double sn = p_over_e * std::sin(4.0 * s.theta_A_rad);
   const double dk = s.damping_scale - 1.0;

@@ -72,7 +72,7 @@ Status PickoffSelfCalibration::add_sample(const WaveSample& s) {
   const double c4 = std::cos(4.0 * s.theta_A_rad);
   const double s4 = std::sin(4.0 * s.theta_A_rad);
   // r = R/E, s = S/E (dsp/wave_variables.hpp), the quadrature reading Q/E.
-  const double p_over_e = (s.a_A_v * s.a_A_v - s.a_B_v * s.a_B_v) / s.E_v2;
+  const double p_over_e = s.p_over_e();
   const double r = p_over_e * c4;
   const double sn = p_over_e * s4;
   const double qn = 2.0 * s.a_A_v * s.a_B_v / s.E_v2;

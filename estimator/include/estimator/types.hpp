@@ -29,6 +29,11 @@ struct WaveSample {
   // amplitude (docs/effects-catalog.md). The identified nu, dnu_C, dnu_S are
   // then those of the reference state. 1: the seed's model (none known).
   double damping_scale{1};
+
+  // P/E = (a_A^2 - a_B^2)/E: the share of the energy in the working wave, the
+  // amplitude of the 4 theta pattern (R, S) = P (cos, sin) 4 theta_A that the
+  // damping anisotropy and the pickoff gain act through.
+  double p_over_e() const { return (a_A_v * a_A_v - a_B_v * a_B_v) / E_v2; }
 };
 
 // p = (nu, dnu_C, dnu_S, dw_C, dw_S) of eq. 20, in this order.
