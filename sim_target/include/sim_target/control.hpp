@@ -87,6 +87,10 @@ class SimTarget {
   // Stage timing of read_block: two host clock reads per stage per chunk of
   // kChunk samples while on, none while off (the default).
   void set_profiling(bool on) { profiling_ = on; }
+  // Whether the resonator-and-noise loop takes its AVX2 form (on by default
+  // where the CPU has AVX2); off, the baseline form gives the same bits.
+  void set_wide_kernels(bool on) { wide_ = on && cpu_has_wide(); }
+  bool wide_kernels() const { return wide_; }
   const SimStageTimes& stage_times() const { return stage_times_; }
   Resonator& resonator() { return resonator_; }
   SimCan& can() { return can_; }
@@ -149,6 +153,10 @@ class SimTarget {
   // Noise on and no burst: the resonator and the noise may share one loop.
   bool plain_noise() const;
   void run_resonator_with_noise(std::size_t n, double dt);
+  template <bool kWide>
+  void resonator_noise_loop(std::size_t n, double dt);
+  void resonator_noise_wide(std::size_t n, double dt);
+  static bool cpu_has_wide();
   uint32_t quantize(std::size_t n, hal::q31_t* out);
   // One ADC conversion with the channel's faults; 1 when it clipped.
   uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {
@@ -165,7 +173,7 @@ class SimTarget {
   }
   // drives_[0..m): the DAC's next m frames through its latency line and quantisers.
   void fill_drives(std::size_t m);
-  // frames_[0..m) through the DAC's latency line (ring).
+  // words_[0..3m) frame by frame through the DAC's latency line (ring).
   void delay_frames(std::size_t m);
   uint64_t sample_time_ns(uint64_t index) const;
 
@@ -203,8 +211,10 @@ class SimTarget {
   double last_pump_v_ = 0.0;
   SimCounters counters_;
   bool profiling_ = false;
+  bool wide_ = cpu_has_wide();
   SimStageTimes stage_times_;
-  std::array<DacFrame, kChunk> frames_{};
+  std::array<hal::q31_t, hal::kDacChannels * kChunk> words_{};  // the DAC's frames, flat
+  std::array<double, hal::kDacChannels * kChunk> drive_v_{};    // their volts
   std::array<Drive, kChunk> drives_{};
   std::array<double, 2 * kChunk> volts_{};
   std::array<double, 2 * kChunk> noise_buf_{};

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "hal/converters.hpp"
 #include "sim_target/sim_config.hpp"
@@ -45,36 +46,60 @@ class AdcQuantizer {
     return r;
   }
   // n conversions of v into out with convert()'s words; returns how many
-  // clipped. A tight loop without a branch per sample: the product is
-  // clamped to one code beyond each rail first (every decision convert()
-  // makes is kept: beyond a rail is beyond it), so that the 1.5 2^52
-  // rounding holds, and a block with a near-tie anywhere is done again by
-  // convert() (see scaled()).
+  // clipped. Two samples at a time without a branch (a pair of doubles is
+  // one SIMD register where the target has one; elsewhere the compiler
+  // splits it, with the same operations per sample): the product is clamped
+  // to one code beyond each rail first (every decision convert() makes is
+  // kept: beyond a rail is beyond it), so that the 1.5 2^52 rounding holds,
+  // and a block with a near-tie anywhere is done again by convert() (see
+  // scaled()).
   uint32_t convert_block(const double* v, hal::q31_t* out, std::size_t n) const {
-    constexpr double kMagic = 0x1.8p52;
-    const double hi = static_cast<double>(code_max_);
-    const double lo = -hi - 1.0;
+    using v2d = double __attribute__((vector_size(16)));
+    using v2l = int64_t __attribute__((vector_size(16)));
+    using v2i = int32_t __attribute__((vector_size(8)));
+    using v2u = uint32_t __attribute__((vector_size(8)));
+    const auto splat = [](double x) { return v2d{x, x}; };
+    const v2d magic = splat(0x1.8p52);
+    const v2d hi = splat(static_cast<double>(code_max_));
+    const v2d lo = splat(-static_cast<double>(code_max_) - 1.0);
+    const v2d above = hi + 1.0;
+    const v2d below = lo - 1.0;
+    const v2d inv = splat(inv_lsb_);
+    const v2d tie = splat(0.5 - kTieGuard);
+    const v2d sign = splat(-0.0);
     const uint32_t shift = 32 - bits_;
-    uint32_t clipped = 0;
-    bool near_tie = !inverse_exact_;
-    for (std::size_t i = 0; i < n; ++i) {
-      double s = v[i] * inv_lsb_;
-      s = s < hi + 1.0 ? s : hi + 1.0;  // NaN goes high, as in code_of()
-      s = s > lo - 1.0 ? s : lo - 1.0;
-      const double r = (s + kMagic) - kMagic;
-      near_tie |= std::fabs(s - r) > 0.5 - kTieGuard;
-      const double c = r < hi ? (r > lo ? r : lo) : hi;
-      clipped += (r >= hi || r <= lo) ? 1u : 0u;
-      out[i] = static_cast<hal::q31_t>(static_cast<uint32_t>(static_cast<int32_t>(c)) << shift);
+    v2l clipped{};  // minus the count per lane (a true comparison is -1)
+    v2l near_tie{};
+    const auto pair = [&](v2d x) {
+      v2d s = x * inv;
+      s = s < above ? s : above;  // NaN goes high, as in code_of()
+      s = s > below ? s : below;
+      const v2d r = (s + magic) - magic;
+      const v2d d = s - r;
+      near_tie |= (v2d)((v2l)d & ~(v2l)sign) > tie;  // |s - r|
+      const v2d c = r < hi ? (r > lo ? r : lo) : hi;
+      clipped += (r >= hi) | (r <= lo);
+      // The code's bits shifted as unsigned (convert() does the same).
+      return (v2i)((v2u) __builtin_convertvector(c, v2i) << shift);
+    };
+    std::size_t i = 0;
+    for (; i + 2 <= n; i += 2) {
+      v2d x;
+      std::memcpy(&x, v + i, sizeof x);
+      const v2i w = pair(x);
+      std::memcpy(out + i, &w, sizeof w);
     }
-    if (!near_tie) return clipped;
-    clipped = 0;
-    for (std::size_t i = 0; i < n; ++i) {
+    if (i < n) out[i] = pair(v2d{v[i], 0.0})[0];  // 0 V neither clips nor ties
+    const auto count_lanes = -(clipped[0] + clipped[1]);
+    uint32_t count = static_cast<uint32_t>(count_lanes);
+    if (inverse_exact_ && (near_tie[0] | near_tie[1]) == 0) return count;
+    count = 0;
+    for (std::size_t k = 0; k < n; ++k) {
       bool clip = false;
-      out[i] = convert(v[i], clip);
-      clipped += clip ? 1u : 0u;
+      out[k] = convert(v[k], clip);
+      count += clip ? 1u : 0u;
     }
-    return clipped;
+    return count;
   }
   // The saturated code of a rounded value (NaN saturates high, as it always has).
   int64_t code_of(double rounded) const {
@@ -112,6 +137,21 @@ class DacQuantizer {
     // code / 2^(bits-1) is exact, so one product by volts_per_code_ rounds as
     // code / 2^(bits-1) * FS did.
     return static_cast<double>(code) * volts_per_code_;
+  }
+  // n conversions of words into volts with convert()'s values; returns how
+  // many saturated. In 32-bit integers (a word's code fits them), without a
+  // branch, so that the compiler converts several words per instruction.
+  uint32_t convert_block(const hal::q31_t* words, double* volts, std::size_t n) const {
+    const auto shift = static_cast<int32_t>(32 - bits_);
+    const auto hi = static_cast<int32_t>(code_max_);
+    const int32_t lo = -hi - 1;
+    uint32_t saturated = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int32_t code = words[i] >> shift;
+      saturated += static_cast<uint32_t>(code >= hi) | static_cast<uint32_t>(code <= lo);
+      volts[i] = static_cast<double>(code) * volts_per_code_;
+    }
+    return saturated;
   }
   // The Q1.31 word whose output is closest to v (tests, envelope helpers).
   hal::q31_t word_for(double v) const;
