@@ -21,6 +21,26 @@
 
 namespace hrg::sim {
 
+// SIMD vectors of kLanes doubles, 64-bit masks and 32-bit words (GCC's
+// vector extensions; a size that depends on a template parameter needs a
+// specialisation per size).
+template <std::size_t kLanes>
+struct Lanes;
+template <>
+struct Lanes<2> {
+  using d = double __attribute__((vector_size(16)));
+  using l = int64_t __attribute__((vector_size(16)));
+  using i = int32_t __attribute__((vector_size(8)));
+  using u = uint32_t __attribute__((vector_size(8)));
+};
+template <>
+struct Lanes<4> {
+  using d = double __attribute__((vector_size(32)));
+  using l = int64_t __attribute__((vector_size(32)));
+  using i = int32_t __attribute__((vector_size(16)));
+  using u = uint32_t __attribute__((vector_size(16)));
+};
+
 class AdcQuantizer {
  public:
   explicit AdcQuantizer(const AdcConfig& c = {});
@@ -46,54 +66,67 @@ class AdcQuantizer {
     return r;
   }
   // n conversions of v into out with convert()'s words; returns how many
-  // clipped. Two samples at a time without a branch (a pair of doubles is
-  // one SIMD register where the target has one; elsewhere the compiler
-  // splits it, with the same operations per sample): the product is clamped
-  // to one code beyond each rail first (every decision convert() makes is
-  // kept: beyond a rail is beyond it), so that the 1.5 2^52 rounding holds,
-  // and a block with a near-tie anywhere is done again by convert() (see
-  // scaled()).
+  // clipped. kLanes samples at a time without a branch (two doubles are one
+  // SIMD register on the baseline targets, four under AVX2; where there is
+  // none the compiler splits the vectors, with the same operations per
+  // sample): the product is clamped to one code beyond each rail first
+  // (every decision convert() makes is kept: beyond a rail is beyond it), so
+  // that the 1.5 2^52 rounding holds, and a block with a near-tie anywhere
+  // is done again by convert() (see scaled()).
   uint32_t convert_block(const double* v, hal::q31_t* out, std::size_t n) const {
-    using v2d = double __attribute__((vector_size(16)));
-    using v2l = int64_t __attribute__((vector_size(16)));
-    using v2i = int32_t __attribute__((vector_size(8)));
-    using v2u = uint32_t __attribute__((vector_size(8)));
-    const auto splat = [](double x) { return v2d{x, x}; };
-    const v2d magic = splat(0x1.8p52);
-    const v2d hi = splat(static_cast<double>(code_max_));
-    const v2d lo = splat(-static_cast<double>(code_max_) - 1.0);
-    const v2d above = hi + 1.0;
-    const v2d below = lo - 1.0;
-    const v2d inv = splat(inv_lsb_);
-    const v2d tie = splat(0.5 - kTieGuard);
-    const v2d sign = splat(-0.0);
+    return convert_lanes<2>(v, out, n);
+  }
+  template <std::size_t kLanes>
+  [[gnu::always_inline]] uint32_t convert_lanes(const double* v, hal::q31_t* out,
+                                                std::size_t n) const {
+    using vd = typename Lanes<kLanes>::d;
+    using vl = typename Lanes<kLanes>::l;
+    using vi = typename Lanes<kLanes>::i;
+    using vu = typename Lanes<kLanes>::u;
+    const vd zero{};
+    const vd magic = zero + 0x1.8p52;
+    const vd hi = zero + static_cast<double>(code_max_);
+    const vd lo = zero + (-static_cast<double>(code_max_) - 1.0);
+    const vd above = hi + 1.0;
+    const vd below = lo - 1.0;
+    const vd inv = zero + inv_lsb_;
+    const vd tie = zero + (0.5 - kTieGuard);
+    const vl magnitude = (vl{} - 1) ^ (vl)(zero - 0.0);  // every bit but the sign
     const uint32_t shift = 32 - bits_;
-    v2l clipped{};  // minus the count per lane (a true comparison is -1)
-    v2l near_tie{};
-    const auto pair = [&](v2d x) {
-      v2d s = x * inv;
+    vl clipped{};  // minus the count per lane (a true comparison is -1)
+    vl near_tie{};
+    const auto lanes = [&](vd x) [[gnu::always_inline]] {
+      vd s = x * inv;
       s = s < above ? s : above;  // NaN goes high, as in code_of()
       s = s > below ? s : below;
-      const v2d r = (s + magic) - magic;
-      const v2d d = s - r;
-      near_tie |= (v2d)((v2l)d & ~(v2l)sign) > tie;  // |s - r|
-      const v2d c = r < hi ? (r > lo ? r : lo) : hi;
+      const vd r = (s + magic) - magic;
+      near_tie |= (vd)((vl)(s - r) & magnitude) > tie;  // |s - r|
+      const vd c = r < hi ? (r > lo ? r : lo) : hi;
       clipped += (r >= hi) | (r <= lo);
       // The code's bits shifted as unsigned (convert() does the same).
-      return (v2i)((v2u) __builtin_convertvector(c, v2i) << shift);
+      return (vi)((vu) __builtin_convertvector(c, vi) << shift);
     };
     std::size_t i = 0;
-    for (; i + 2 <= n; i += 2) {
-      v2d x;
+    for (; i + kLanes <= n; i += kLanes) {
+      vd x;
       std::memcpy(&x, v + i, sizeof x);
-      const v2i w = pair(x);
+      const vi w = lanes(x);
       std::memcpy(out + i, &w, sizeof w);
     }
-    if (i < n) out[i] = pair(v2d{v[i], 0.0})[0];  // 0 V neither clips nor ties
-    const auto count_lanes = -(clipped[0] + clipped[1]);
-    uint32_t count = static_cast<uint32_t>(count_lanes);
-    if (inverse_exact_ && (near_tie[0] | near_tie[1]) == 0) return count;
-    count = 0;
+    if (i < n) {  // the rest with 0 V in the spare lanes: it neither clips nor ties
+      vd x{};
+      std::memcpy(&x, v + i, (n - i) * sizeof(double));
+      const vi w = lanes(x);
+      std::memcpy(out + i, &w, (n - i) * sizeof(hal::q31_t));
+    }
+    int64_t lanes_clipped = 0;
+    int64_t lanes_near_tie = 0;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      lanes_clipped -= clipped[l];
+      lanes_near_tie |= near_tie[l];
+    }
+    if (inverse_exact_ && lanes_near_tie == 0) return static_cast<uint32_t>(lanes_clipped);
+    uint32_t count = 0;
     for (std::size_t k = 0; k < n; ++k) {
       bool clip = false;
       out[k] = convert(v[k], clip);
