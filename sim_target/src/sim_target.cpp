@@ -204,12 +204,24 @@ class StageLaps {
 }  // namespace
 
 void SimTarget::run_resonator(std::size_t n, double dt) {
+  if (wide_) {
+    resonator_wide(n, dt);
+  } else {
+    resonator_loop<false>(n, dt);
+  }
+}
+
+template <bool kWide>
+[[gnu::always_inline]] inline void SimTarget::resonator_loop(std::size_t n, double dt) {
   const double offset_x = config_.adc.offset_v[0];
   const double offset_y = config_.adc.offset_v[1];
-  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
-    volts_[2 * k] = p.x_v + offset_x;
-    volts_[2 * k + 1] = p.y_v + offset_y;
-  });
+  double* volts = volts_.data();
+  resonator_.step_block<kWide>(drives_.data(), n, dt,
+                               [volts, offset_x, offset_y](std::size_t k, const PickoffOutput& p)
+                                   [[gnu::always_inline]] {
+                                     volts[2 * k] = p.x_v + offset_x;
+                                     volts[2 * k + 1] = p.y_v + offset_y;
+                                   });
 }
 
 bool SimTarget::plain_noise() const {
@@ -247,6 +259,11 @@ template <bool kWide>
   resonator_noise_loop<true>(n, dt);
 }
 
+// The resonator alone (noise added apart: bursts, profiling), as above.
+[[gnu::target("avx2")]] void SimTarget::resonator_wide(std::size_t n, double dt) {
+  resonator_loop<true>(n, dt);
+}
+
 // The DAC's conversions with the compiler's AVX2 vectors (integers to
 // doubles and one product each: exact, so the same bits).
 [[gnu::target("avx2")]] void SimTarget::fill_drives_wide(std::size_t m) { fill_drives_loop(m); }
@@ -259,6 +276,8 @@ template <bool kWide>
 
 bool SimTarget::cpu_has_wide() { return __builtin_cpu_supports("avx2") != 0; }
 #else
+void SimTarget::resonator_wide(std::size_t n, double dt) { resonator_loop<false>(n, dt); }
+
 void SimTarget::fill_drives_wide(std::size_t m) { fill_drives_loop(m); }
 
 uint32_t SimTarget::convert_wide(const double* v, hal::q31_t* out, std::size_t n) const {

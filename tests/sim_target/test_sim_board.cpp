@@ -482,9 +482,10 @@ TEST(SimBoard, WideAndBaselineResonatorLoopsGiveTheSameBits) {
   c.resonator.th_w_rad = 0.3;
   c.resonator.th_mu_rad = -0.2;
   const DacQuantizer q(c.dac);
-  const auto run = [&](bool wide) {
+  const auto run = [&](bool wide, bool profile) {
     target().configure(c);
     target().set_wide_kernels(wide);
+    target().set_profiling(profile);  // the resonator and the noise in separate loops
     CHECK_EQUAL(wide && target().wide_kernels(), target().wide_kernels());
     hal::Board& b = hal::board();
     CHECK(b.excitation_enable.write(true) == hal::Status::ok);
@@ -514,10 +515,13 @@ TEST(SimBoard, WideAndBaselineResonatorLoopsGiveTheSameBits) {
     }
     return words;
   };
-  const auto wide = run(true);
+  const auto wide = run(true, false);
   const bool took_wide = target().wide_kernels();
-  const auto base = run(false);
+  const auto base = run(false, false);
+  const auto wide_apart = run(true, true);
+  target().set_profiling(false);
   CHECK(wide == base);
+  CHECK(wide_apart == base);
   std::printf("\n  wide resonator loop %s on this CPU\n", took_wide ? "taken" : "not available");
 }
 

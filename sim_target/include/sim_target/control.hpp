@@ -149,6 +149,9 @@ class SimTarget {
 
   hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped);
   void run_resonator(std::size_t n, double dt);
+  template <bool kWide>
+  void resonator_loop(std::size_t n, double dt);
+  void resonator_wide(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   // Noise on and no burst: the resonator and the noise may share one loop.
   bool plain_noise() const;

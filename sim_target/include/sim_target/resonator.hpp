@@ -252,10 +252,11 @@ class Resonator {
     const double k_pump = electrodes_.pump_gain_per_s2_v2;
     const double k_spring = spring_k_;
     v4d u = {u_(0), u_(1), u_(2), u_(3)};
+    PumpRing pump_ring(*this);
     for (std::size_t k = 0; k < n; ++k) {
       sink(k, PickoffOutput{u[0], u[1]});
       const Drive d = drives[k];
-      const double v2_dc = push_pump(d.pump_v);
+      const double v2_dc = pump_ring.push(d.pump_v);
       const double v2 = d.pump_v * d.pump_v;
       const double c_gap = k_pump * (v2 - v2_dc) + k_spring * v2_dc;
       const v4d u0 = {u[0], u[0], u[0], u[0]};
@@ -269,6 +270,7 @@ class Resonator {
       const v4d cg = {c_gap, c_gap, c_gap, c_gap};
       u = (rate + (gx * fx + gy * fy)) + cg * pump;
     }
+    pump_ring.store();
     steps_ += n;
     u_ << u[0], u[1], u[2], u[3];
   }
@@ -282,6 +284,47 @@ class Resonator {
   };
   HeldCoefficients prepare_held(double rate_rad_s, double temp_c, double dt_s);
   double pump_delayed(double delay_samples) const;
+  // The pump history's position and running sum in locals over a loop of
+  // steps (registers: the caller's stores could alias the members), the
+  // same operations as push_pump(); back into the members by store().
+  struct PumpRing {
+    explicit PumpRing(Resonator& r)
+        : res(r),
+          hist(r.pump_hist_.data()),
+          sq(r.pump_sq_hist_.data()),
+          pos(r.hist_pos_),
+          avg(r.avg_len_),
+          sum(r.pump_sq_sum_),
+          valid(r.pump_sum_valid_) {}
+    [[gnu::always_inline]] double push(double pump_v) {
+      constexpr int kMask = kHistory - 1;
+      pos = (pos + 1) & kMask;
+      const double leaving = sq[(pos - avg) & kMask];
+      hist[pos] = pump_v;
+      sq[pos] = pump_v * pump_v;
+      if (pos == 0 || !valid) [[unlikely]] {
+        store();
+        res.readd_pump_squares();
+        sum = res.pump_sq_sum_;
+        valid = true;
+      } else {
+        sum += sq[pos] - leaving;
+      }
+      return sum / avg;
+    }
+    void store() const {
+      res.hist_pos_ = pos;
+      res.pump_sq_sum_ = sum;
+      res.pump_sum_valid_ = valid;
+    }
+    Resonator& res;
+    double* hist;
+    double* sq;
+    int pos;
+    int avg;
+    double sum;
+    bool valid;
+  };
   double push_pump(double pump_v) {      // records the held pump voltage, returns <V^2>
     constexpr int kMask = kHistory - 1;  // kHistory is a power of two
     hist_pos_ = (hist_pos_ + 1) & kMask;
