@@ -216,12 +216,13 @@ template <bool kWide>
   const double offset_x = config_.adc.offset_v[0];
   const double offset_y = config_.adc.offset_v[1];
   double* volts = volts_.data();
-  resonator_.step_block<kWide>(drives_.data(), n, dt,
-                               [volts, offset_x, offset_y](std::size_t k, const PickoffOutput& p)
-                                   [[gnu::always_inline]] {
-                                     volts[2 * k] = p.x_v + offset_x;
-                                     volts[2 * k + 1] = p.y_v + offset_y;
-                                   });
+  resonator_.step_block<kWide>(
+      drives_.data(), n, dt,
+      [ volts, offset_x, offset_y ](std::size_t k, const PickoffOutput& p)
+          __attribute__((always_inline)) {
+            volts[2 * k] = p.x_v + offset_x;
+            volts[2 * k + 1] = p.y_v + offset_y;
+          });
 }
 
 bool SimTarget::plain_noise() const {
@@ -240,14 +241,15 @@ template <bool kWide>
   const double rms_y = config_.adc.noise_v_rms[1];
   double* volts = volts_.data();
   detail::Gaussian::Stream noise(noise_);
-  resonator_.step_block<kWide>(drives_.data(), n, dt,
-                               [volts, offset_x, offset_y, rms_x, rms_y, &noise](
-                                   std::size_t k, const PickoffOutput& p) [[gnu::always_inline]] {
-                                 const double nx = noise.normal();
-                                 const double ny = noise.normal();
-                                 volts[2 * k] = (p.x_v + offset_x) + rms_x * nx;
-                                 volts[2 * k + 1] = (p.y_v + offset_y) + rms_y * ny;
-                               });
+  resonator_.step_block<kWide>(
+      drives_.data(), n, dt,
+      [ volts, offset_x, offset_y, rms_x, rms_y, &noise ](std::size_t k, const PickoffOutput& p)
+          __attribute__((always_inline)) {
+            const double nx = noise.normal();
+            const double ny = noise.normal();
+            volts[2 * k] = (p.x_v + offset_x) + rms_x * nx;
+            volts[2 * k + 1] = (p.y_v + offset_y) + rms_y * ny;
+          });
   noise.commit();
 }
 

@@ -95,7 +95,7 @@ class AdcQuantizer {
     const uint32_t shift = 32 - bits_;
     vl clipped{};  // minus the count per lane (a true comparison is -1)
     vl near_tie{};
-    const auto lanes = [&](vd x) [[gnu::always_inline]] {
+    const auto lanes = [&](const vd& x) __attribute__((always_inline)) {
       vd s = x * inv;
       s = s < above ? s : above;  // NaN goes high, as in code_of()
       s = s > below ? s : below;
