@@ -276,7 +276,10 @@ template <bool kWide>
   return adc_q_.convert_lanes<4>(v, out, n);
 }
 
-bool SimTarget::cpu_has_wide() { return __builtin_cpu_supports("avx2") != 0; }
+bool SimTarget::cpu_has_wide() {
+  __builtin_cpu_init();  // a SimTarget may be built before the constructors that run it
+  return __builtin_cpu_supports("avx2") != 0;
+}
 #else
 void SimTarget::resonator_wide(std::size_t n, double dt) { resonator_loop<false>(n, dt); }
 
