@@ -9,6 +9,14 @@
 
 #include "sim_target/averaged_model.hpp"
 
+// The resonator-and-noise loop has an AVX2 form where GCC targets x86-64
+// (chosen at run time by the CPU, see resonator_noise_wide()).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define HRG_SIM_WIDE 1
+#else
+#define HRG_SIM_WIDE 0
+#endif
+
 namespace hrg::sim {
 
 using hal::Status;
@@ -33,9 +41,10 @@ void SimTarget::configure(const SimConfig& c) {
   excitation_.value = false;
   fault_input_.value = false;
   sample_index_ = 0;
-  std::vector<DacFrame>().swap(dac_queue_);
+  std::vector<hal::q31_t>().swap(dac_queue_);
   dac_head_ = 0;
-  std::vector<DacFrame>(c.dac.latency_samples, DacFrame{}).swap(dac_latency_);
+  std::vector<hal::q31_t>(hal::kDacChannels * c.dac.latency_samples, 0).swap(dac_latency_);
+  std::vector<hal::q31_t>(dac_latency_.size(), 0).swap(latency_spare_);
   latency_pos_ = 0;
   dac_written_ = false;
   adc_stuck_ = {};
@@ -114,45 +123,61 @@ TrueState SimTarget::true_state() const {
 }
 
 void SimTarget::fill_drives(std::size_t m) {
+  if (wide_) {
+    fill_drives_wide(m);
+  } else {
+    fill_drives_loop(m);
+  }
+}
+
+[[gnu::always_inline]] inline void SimTarget::fill_drives_loop(std::size_t m) {
   // Double buffer: the frames the firmware queued, then zeros when none is
   // waiting (an underrun once the firmware has written).
-  const std::size_t queued = std::min(dac_queue_.size() - dac_head_, m);
+  constexpr std::size_t kCh = hal::kDacChannels;
+  const std::size_t queued = std::min(dac_queue_.size() / kCh - dac_head_, m);
   if (queued < m && dac_written_) counters_.dac_underruns += m - queued;
-  std::copy_n(dac_queue_.data() + dac_head_, queued, frames_.begin());
-  std::fill_n(frames_.begin() + static_cast<std::ptrdiff_t>(queued), m - queued, DacFrame{});
+  if (queued > 0) std::copy_n(dac_queue_.data() + kCh * dac_head_, kCh * queued, words_.data());
+  std::fill_n(words_.begin() + static_cast<std::ptrdiff_t>(kCh * queued), kCh * (m - queued), 0);
   if (!dac_latency_.empty()) delay_frames(m);
-  // A channel is gated off (0 V) while the excitation is off or it is dead;
-  // its codes still count at the rails.
-  std::array<bool, hal::kDacChannels> live{};
-  for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch)
+  // Every code counts at the rails; a channel is gated off (0 V) while the
+  // excitation is off or it is dead.
+  counters_.dac_saturated += dac_q_.convert_block(words_.data(), drive_v_.data(), kCh * m);
+  std::array<bool, kCh> live{};
+  for (std::size_t ch = 0; ch < kCh; ++ch)
     live[ch] = excitation_.value && !dac_dead_[ch];
-  uint64_t saturated = 0;
-  for (std::size_t k = 0; k < m; ++k) {
-    std::array<double, hal::kDacChannels> v{};
-    for (std::size_t ch = 0; ch < hal::kDacChannels; ++ch) {
-      bool rail = false;
-      const double volts = dac_q_.convert(frames_[k][ch], rail);
-      saturated += rail ? 1 : 0;
-      v[ch] = live[ch] ? volts : 0.0;
-    }
-    drives_[k] = Drive{v[0], v[1], v[2]};
-  }
-  counters_.dac_saturated += saturated;
+  const double* v = drive_v_.data();
+  for (std::size_t k = 0; k < m; ++k, v += kCh)
+    drives_[k] = Drive{live[0] ? v[0] : 0.0, live[1] ? v[1] : 0.0, live[2] ? v[2] : 0.0};
   dac_head_ += queued;
-  if (dac_head_ == dac_queue_.size()) {
+  if (kCh * dac_head_ == dac_queue_.size()) {
     dac_queue_.clear();
     dac_head_ = 0;
   }
 }
 
 void SimTarget::delay_frames(std::size_t m) {
-  const std::size_t latency = dac_latency_.size();
-  std::size_t pos = latency_pos_;
-  for (std::size_t k = 0; k < m; ++k) {
-    std::swap(frames_[k], dac_latency_[pos]);
-    pos = pos + 1 == latency ? 0 : pos + 1;
+  constexpr std::size_t kCh = hal::kDacChannels;
+  const std::size_t latency = dac_latency_.size() / kCh;
+  hal::q31_t* in = words_.data();
+  if (m < latency) {  // frame k leaves the ring at pos and frame k's input takes its place
+    std::size_t pos = latency_pos_;
+    for (std::size_t k = 0; k < m; ++k) {
+      std::swap_ranges(in + kCh * k, in + kCh * (k + 1), dac_latency_.data() + kCh * pos);
+      pos = pos + 1 == latency ? 0 : pos + 1;
+    }
+    latency_pos_ = pos;
+    return;
   }
-  latency_pos_ = pos;
+  // The same as m swaps, as three copies: the last `latency` inputs become
+  // the ring, the others move up by `latency` frames, and the ring's frames
+  // (oldest first, from pos) come first.
+  const auto ring_pos = static_cast<std::ptrdiff_t>(kCh * latency_pos_);
+  std::copy_n(in + kCh * (m - latency), kCh * latency, latency_spare_.begin());
+  std::copy_backward(in, in + kCh * (m - latency), in + kCh * m);
+  const auto oldest = std::copy(dac_latency_.begin() + ring_pos, dac_latency_.end(), in);
+  std::copy(dac_latency_.begin(), dac_latency_.begin() + ring_pos, oldest);
+  dac_latency_.swap(latency_spare_);
+  latency_pos_ = 0;
 }
 
 namespace {
@@ -179,12 +204,25 @@ class StageLaps {
 }  // namespace
 
 void SimTarget::run_resonator(std::size_t n, double dt) {
+  if (wide_) {
+    resonator_wide(n, dt);
+  } else {
+    resonator_loop<false>(n, dt);
+  }
+}
+
+template <bool kWide>
+[[gnu::always_inline]] inline void SimTarget::resonator_loop(std::size_t n, double dt) {
   const double offset_x = config_.adc.offset_v[0];
   const double offset_y = config_.adc.offset_v[1];
-  resonator_.step_block(drives_.data(), n, dt, [&](std::size_t k, const PickoffOutput& p) {
-    volts_[2 * k] = p.x_v + offset_x;
-    volts_[2 * k + 1] = p.y_v + offset_y;
-  });
+  double* volts = volts_.data();
+  resonator_.step_block<kWide>(
+      drives_.data(), n, dt,
+      [ volts, offset_x, offset_y ](std::size_t k, const PickoffOutput& p)
+          __attribute__((always_inline)) {
+            volts[2 * k] = p.x_v + offset_x;
+            volts[2 * k + 1] = p.y_v + offset_y;
+          });
 }
 
 bool SimTarget::plain_noise() const {
@@ -192,7 +230,8 @@ bool SimTarget::plain_noise() const {
   return (rms[0] != 0.0 || rms[1] != 0.0) && !(burst_left_s_ > 0.0);
 }
 
-void SimTarget::run_resonator_with_noise(std::size_t n, double dt) {
+template <bool kWide>
+[[gnu::always_inline]] inline void SimTarget::resonator_noise_loop(std::size_t n, double dt) {
   // run_resonator() and add_noise() in one loop, the same expressions and
   // draws in the same order: the normals are drawn while the step's
   // dependency chain runs.
@@ -202,15 +241,67 @@ void SimTarget::run_resonator_with_noise(std::size_t n, double dt) {
   const double rms_y = config_.adc.noise_v_rms[1];
   double* volts = volts_.data();
   detail::Gaussian::Stream noise(noise_);
-  resonator_.step_block(
+  resonator_.step_block<kWide>(
       drives_.data(), n, dt,
-      [volts, offset_x, offset_y, rms_x, rms_y, &noise](std::size_t k, const PickoffOutput& p) {
-        const double nx = noise.normal();
-        const double ny = noise.normal();
-        volts[2 * k] = (p.x_v + offset_x) + rms_x * nx;
-        volts[2 * k + 1] = (p.y_v + offset_y) + rms_y * ny;
-      });
+      [ volts, offset_x, offset_y, rms_x, rms_y, &noise ](std::size_t k, const PickoffOutput& p)
+          __attribute__((always_inline)) {
+            const double nx = noise.normal();
+            const double ny = noise.normal();
+            volts[2 * k] = (p.x_v + offset_x) + rms_x * nx;
+            volts[2 * k + 1] = (p.y_v + offset_y) + rms_y * ny;
+          });
   noise.commit();
+}
+
+#if HRG_SIM_WIDE
+// The same loop compiled for AVX2: the resonator's held-inputs step on four
+// rows at a time (Resonator::step_wide()); everything else as compiled for
+// the baseline, with the same bits (AVX2 brings no fused multiply-add).
+[[gnu::target("avx2")]] void SimTarget::resonator_noise_wide(std::size_t n, double dt) {
+  resonator_noise_loop<true>(n, dt);
+}
+
+// The resonator alone (noise added apart: bursts, profiling), as above.
+[[gnu::target("avx2")]] void SimTarget::resonator_wide(std::size_t n, double dt) {
+  resonator_loop<true>(n, dt);
+}
+
+// The DAC's conversions with the compiler's AVX2 vectors (integers to
+// doubles and one product each: exact, so the same bits).
+[[gnu::target("avx2")]] void SimTarget::fill_drives_wide(std::size_t m) { fill_drives_loop(m); }
+
+// The ADC's conversions four at a time (AdcQuantizer::convert_lanes()).
+[[gnu::target("avx2")]] uint32_t SimTarget::convert_wide(const double* v, hal::q31_t* out,
+                                                         std::size_t n) const {
+  return adc_q_.convert_lanes<4>(v, out, n);
+}
+
+bool SimTarget::cpu_has_wide() {
+  __builtin_cpu_init();  // a SimTarget may be built before the constructors that run it
+  return __builtin_cpu_supports("avx2") != 0;
+}
+#else
+void SimTarget::resonator_wide(std::size_t n, double dt) { resonator_loop<false>(n, dt); }
+
+void SimTarget::fill_drives_wide(std::size_t m) { fill_drives_loop(m); }
+
+uint32_t SimTarget::convert_wide(const double* v, hal::q31_t* out, std::size_t n) const {
+  return adc_q_.convert_block(v, out, n);
+}
+
+void SimTarget::resonator_noise_wide(std::size_t n, double dt) {
+  resonator_noise_loop<false>(n, dt);
+}
+
+bool SimTarget::cpu_has_wide() { return false; }
+#endif
+
+void SimTarget::run_resonator_with_noise(std::size_t n, double dt) {
+  if (wide_) {
+    resonator_noise_wide(n, dt);
+  } else {
+    resonator_noise_loop<false>(n, dt);
+  }
 }
 
 void SimTarget::add_noise(std::size_t n, double dt) {
@@ -245,7 +336,8 @@ uint32_t SimTarget::quantize(std::size_t n, hal::q31_t* out) {
     }
     return clipped;
   }
-  clipped = adc_q_.convert_block(volts_.data(), out, 2 * n);
+  clipped = wide_ ? convert_wide(volts_.data(), out, 2 * n)
+                  : adc_q_.convert_block(volts_.data(), out, 2 * n);
   if (n > 0) adc_last_ = {out[2 * n - 2], out[2 * n - 1]};  // what a stuck channel holds
   return clipped;
 }
@@ -317,13 +409,9 @@ hal::ConverterInfo SimTarget::SimDac::info() const {
 Status SimTarget::SimDac::write_block(std::span<const hal::q31_t> frames) {
   const std::size_t n = t->config_.adc.block_frames;
   if (frames.size() != n * hal::kDacChannels) return Status::invalid_argument;
-  if (t->dac_queue_.size() - t->dac_head_ >= 4 * n)
+  if (t->dac_queue_.size() / hal::kDacChannels - t->dac_head_ >= 4 * n)
     return Status::would_block;  // four blocks ahead at most
-  // Whole frames in one copy (a DacFrame is the block's three words).
-  static_assert(sizeof(DacFrame) == hal::kDacChannels * sizeof(hal::q31_t));
-  const std::size_t old = t->dac_queue_.size();
-  t->dac_queue_.resize(old + n);
-  std::memcpy(t->dac_queue_.data() + old, frames.data(), n * sizeof(DacFrame));
+  t->dac_queue_.insert(t->dac_queue_.end(), frames.begin(), frames.end());  // one copy
   t->dac_written_ = true;
   return Status::ok;
 }

@@ -45,6 +45,11 @@ def write_csv(study, path):
             w.writerow(row)
 
 
+def none_as_nan(v):
+    """A figure the study could not measure (null in the JSON) printed as nan."""
+    return float("nan") if v is None else v
+
+
 def summary(study):
     print("tolerance study: %d points x %d seeds of %.0f s (grid %s)" %
           (len(study["points"]), study["seeds"], study["duration_s"], study["grid"]))
@@ -58,10 +63,11 @@ def summary(study):
         verdict = "within 2x" if p["meets_bound"] else (
             "; ".join(p["reasons"]) if p["reasons"] else "MISSES 2x WITH NO KNOWN CAUSE")
         met += p["meets_bound"]
-        ratio = p["ratio"] if p["ratio"] is not None else float("nan")
+        ratio = none_as_nan(p["ratio"])
         print("%5d %9.2g %6.3g %6.3g %8.2g %9.4g %9.4g %9.4g %6.2f %s %s %s  %s" %
-              (p["point"], p["split_hz"], p["dq_over_q"], p["gap"], p["q"], p["raw_adb_dph"],
-               p["comp_adb_dph"], p["predicted_adb_dph"], ratio, t[0], t[1], t[2], verdict))
+              (p["point"], p["split_hz"], p["dq_over_q"], p["gap"], p["q"],
+               none_as_nan(p["raw_adb_dph"]), none_as_nan(p["comp_adb_dph"]),
+               p["predicted_adb_dph"], ratio, t[0], t[1], t[2], verdict))
     print("%d of %d points within 2x the bound; the others carry their reason" %
           (met, len(study["points"])))
 
@@ -74,8 +80,10 @@ def plane_panels(points):
 
 
 def compensated(point):
-    """Whether any seed of the point had its compensation applied (a compensated ADB exists)."""
-    return any(r.get("compensation_applied", True) for r in point.get("per_seed", [{}]))
+    """Whether a compensated ADB exists: some seed had its compensation applied and
+    its parks spread enough for the 4 theta fit (a null ADB is not measured)."""
+    return point["comp_adb_dph"] is not None and any(
+        r.get("compensation_applied", True) for r in point.get("per_seed", [{}]))
 
 
 def masked(rows):

@@ -87,6 +87,11 @@ class SimTarget {
   // Stage timing of read_block: two host clock reads per stage per chunk of
   // kChunk samples while on, none while off (the default).
   void set_profiling(bool on) { profiling_ = on; }
+  // Whether the resonator-and-noise loop and the ADC take their AVX2 forms
+  // (on by default where the CPU has AVX2); off, the baseline forms give the
+  // same bits.
+  void set_wide_kernels(bool on) { wide_ = on && cpu_has_wide(); }
+  bool wide_kernels() const { return wide_; }
   const SimStageTimes& stage_times() const { return stage_times_; }
   Resonator& resonator() { return resonator_; }
   SimCan& can() { return can_; }
@@ -137,7 +142,6 @@ class SimTarget {
     double lagged_c = 0.0;
     double last_t_s = 0.0;
   };
-  using DacFrame = std::array<hal::q31_t, hal::kDacChannels>;
 
   // A block is produced in chunks of at most kChunk samples through fixed
   // buffers (nothing is allocated while running).
@@ -145,10 +149,18 @@ class SimTarget {
 
   hal::Status produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_ns, uint32_t& clipped);
   void run_resonator(std::size_t n, double dt);
+  template <bool kWide>
+  void resonator_loop(std::size_t n, double dt);
+  void resonator_wide(std::size_t n, double dt);
   void add_noise(std::size_t n, double dt);
   // Noise on and no burst: the resonator and the noise may share one loop.
   bool plain_noise() const;
   void run_resonator_with_noise(std::size_t n, double dt);
+  template <bool kWide>
+  void resonator_noise_loop(std::size_t n, double dt);
+  void resonator_noise_wide(std::size_t n, double dt);
+  uint32_t convert_wide(const double* v, hal::q31_t* out, std::size_t n) const;
+  static bool cpu_has_wide();
   uint32_t quantize(std::size_t n, hal::q31_t* out);
   // One ADC conversion with the channel's faults; 1 when it clipped.
   uint32_t quantize_sample(std::size_t ch, double v, hal::q31_t& out) {
@@ -165,7 +177,9 @@ class SimTarget {
   }
   // drives_[0..m): the DAC's next m frames through its latency line and quantisers.
   void fill_drives(std::size_t m);
-  // frames_[0..m) through the DAC's latency line (ring).
+  void fill_drives_loop(std::size_t m);
+  void fill_drives_wide(std::size_t m);
+  // words_[0..3m) frame by frame through the DAC's latency line (ring).
   void delay_frames(std::size_t m);
   uint64_t sample_time_ns(uint64_t index) const;
 
@@ -186,9 +200,10 @@ class SimTarget {
   uint64_t sample_index_ = 0;
   // Queued DAC frames [dac_head_, end) and the latency line (ring); plain
   // vectors so that configure() can release every allocation.
-  std::vector<DacFrame> dac_queue_;
-  std::size_t dac_head_ = 0;
-  std::vector<DacFrame> dac_latency_;
+  std::vector<hal::q31_t> dac_queue_;      // frames, flat
+  std::size_t dac_head_ = 0;               // in frames
+  std::vector<hal::q31_t> dac_latency_;    // latency_samples frames, flat
+  std::vector<hal::q31_t> latency_spare_;  // its size: the next ring
   std::size_t latency_pos_ = 0;
   bool dac_written_ = false;
   std::array<bool, 2> adc_stuck_{};
@@ -203,8 +218,10 @@ class SimTarget {
   double last_pump_v_ = 0.0;
   SimCounters counters_;
   bool profiling_ = false;
+  bool wide_ = cpu_has_wide();
   SimStageTimes stage_times_;
-  std::array<DacFrame, kChunk> frames_{};
+  std::array<hal::q31_t, hal::kDacChannels * kChunk> words_{};  // the DAC's frames, flat
+  std::array<double, hal::kDacChannels * kChunk> drive_v_{};    // their volts
   std::array<Drive, kChunk> drives_{};
   std::array<double, 2 * kChunk> volts_{};
   std::array<double, 2 * kChunk> noise_buf_{};

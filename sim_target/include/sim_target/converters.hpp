@@ -14,11 +14,32 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "hal/converters.hpp"
 #include "sim_target/sim_config.hpp"
 
 namespace hrg::sim {
+
+// SIMD vectors of kLanes doubles, 64-bit masks and 32-bit words (GCC's
+// vector extensions; a size that depends on a template parameter needs a
+// specialisation per size).
+template <std::size_t kLanes>
+struct Lanes;
+template <>
+struct Lanes<2> {
+  using d = double __attribute__((vector_size(16)));
+  using l = int64_t __attribute__((vector_size(16)));
+  using i = int32_t __attribute__((vector_size(8)));
+  using u = uint32_t __attribute__((vector_size(8)));
+};
+template <>
+struct Lanes<4> {
+  using d = double __attribute__((vector_size(32)));
+  using l = int64_t __attribute__((vector_size(32)));
+  using i = int32_t __attribute__((vector_size(16)));
+  using u = uint32_t __attribute__((vector_size(16)));
+};
 
 class AdcQuantizer {
  public:
@@ -45,36 +66,73 @@ class AdcQuantizer {
     return r;
   }
   // n conversions of v into out with convert()'s words; returns how many
-  // clipped. A tight loop without a branch per sample: the product is
-  // clamped to one code beyond each rail first (every decision convert()
-  // makes is kept: beyond a rail is beyond it), so that the 1.5 2^52
-  // rounding holds, and a block with a near-tie anywhere is done again by
-  // convert() (see scaled()).
+  // clipped. kLanes samples at a time without a branch (two doubles are one
+  // SIMD register on the baseline targets, four under AVX2; where there is
+  // none the compiler splits the vectors, with the same operations per
+  // sample): the product is clamped to one code beyond each rail first
+  // (every decision convert() makes is kept: beyond a rail is beyond it), so
+  // that the 1.5 2^52 rounding holds, and a block with a near-tie anywhere
+  // is done again by convert() (see scaled()).
   uint32_t convert_block(const double* v, hal::q31_t* out, std::size_t n) const {
-    constexpr double kMagic = 0x1.8p52;
-    const double hi = static_cast<double>(code_max_);
-    const double lo = -hi - 1.0;
+    return convert_lanes<2>(v, out, n);
+  }
+  template <std::size_t kLanes>
+  [[gnu::always_inline]] uint32_t convert_lanes(const double* v, hal::q31_t* out,
+                                                std::size_t n) const {
+    using vd = typename Lanes<kLanes>::d;
+    using vl = typename Lanes<kLanes>::l;
+    using vi = typename Lanes<kLanes>::i;
+    using vu = typename Lanes<kLanes>::u;
+    const vd zero{};
+    const vd magic = zero + 0x1.8p52;
+    const vd hi = zero + static_cast<double>(code_max_);
+    const vd lo = zero + (-static_cast<double>(code_max_) - 1.0);
+    const vd above = hi + 1.0;
+    const vd below = lo - 1.0;
+    const vd inv = zero + inv_lsb_;
+    const vd tie = zero + (0.5 - kTieGuard);
+    const vl magnitude = (vl{} - 1) ^ (vl)(zero - 0.0);  // every bit but the sign
     const uint32_t shift = 32 - bits_;
-    uint32_t clipped = 0;
-    bool near_tie = !inverse_exact_;
-    for (std::size_t i = 0; i < n; ++i) {
-      double s = v[i] * inv_lsb_;
-      s = s < hi + 1.0 ? s : hi + 1.0;  // NaN goes high, as in code_of()
-      s = s > lo - 1.0 ? s : lo - 1.0;
-      const double r = (s + kMagic) - kMagic;
-      near_tie |= std::fabs(s - r) > 0.5 - kTieGuard;
-      const double c = r < hi ? (r > lo ? r : lo) : hi;
-      clipped += (r >= hi || r <= lo) ? 1u : 0u;
-      out[i] = static_cast<hal::q31_t>(static_cast<uint32_t>(static_cast<int32_t>(c)) << shift);
+    vl clipped{};  // minus the count per lane (a true comparison is -1)
+    vl near_tie{};
+    const auto lanes = [&](const vd& x) __attribute__((always_inline)) {
+      vd s = x * inv;
+      s = s < above ? s : above;  // NaN goes high, as in code_of()
+      s = s > below ? s : below;
+      const vd r = (s + magic) - magic;
+      near_tie |= (vd)((vl)(s - r) & magnitude) > tie;  // |s - r|
+      const vd c = r < hi ? (r > lo ? r : lo) : hi;
+      clipped += (r >= hi) | (r <= lo);
+      // The code's bits shifted as unsigned (convert() does the same).
+      return (vi)((vu) __builtin_convertvector(c, vi) << shift);
+    };
+    std::size_t i = 0;
+    for (; i + kLanes <= n; i += kLanes) {
+      vd x;
+      std::memcpy(&x, v + i, sizeof x);
+      const vi w = lanes(x);
+      std::memcpy(out + i, &w, sizeof w);
     }
-    if (!near_tie) return clipped;
-    clipped = 0;
-    for (std::size_t i = 0; i < n; ++i) {
+    if (i < n) {  // the rest with 0 V in the spare lanes: it neither clips nor ties
+      vd x{};
+      std::memcpy(&x, v + i, (n - i) * sizeof(double));
+      const vi w = lanes(x);
+      std::memcpy(out + i, &w, (n - i) * sizeof(hal::q31_t));
+    }
+    int64_t lanes_clipped = 0;
+    int64_t lanes_near_tie = 0;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      lanes_clipped -= clipped[l];
+      lanes_near_tie |= near_tie[l];
+    }
+    if (inverse_exact_ && lanes_near_tie == 0) return static_cast<uint32_t>(lanes_clipped);
+    uint32_t count = 0;
+    for (std::size_t k = 0; k < n; ++k) {
       bool clip = false;
-      out[i] = convert(v[i], clip);
-      clipped += clip ? 1u : 0u;
+      out[k] = convert(v[k], clip);
+      count += clip ? 1u : 0u;
     }
-    return clipped;
+    return count;
   }
   // The saturated code of a rounded value (NaN saturates high, as it always has).
   int64_t code_of(double rounded) const {
@@ -112,6 +170,21 @@ class DacQuantizer {
     // code / 2^(bits-1) is exact, so one product by volts_per_code_ rounds as
     // code / 2^(bits-1) * FS did.
     return static_cast<double>(code) * volts_per_code_;
+  }
+  // n conversions of words into volts with convert()'s values; returns how
+  // many saturated. In 32-bit integers (a word's code fits them), without a
+  // branch, so that the compiler converts several words per instruction.
+  uint32_t convert_block(const hal::q31_t* words, double* volts, std::size_t n) const {
+    const auto shift = static_cast<int32_t>(32 - bits_);
+    const auto hi = static_cast<int32_t>(code_max_);
+    const int32_t lo = -hi - 1;
+    uint32_t saturated = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int32_t code = words[i] >> shift;
+      saturated += static_cast<uint32_t>(code >= hi) | static_cast<uint32_t>(code <= lo);
+      volts[i] = static_cast<double>(code) * volts_per_code_;
+    }
+    return saturated;
   }
   // The Q1.31 word whose output is closest to v (tests, envelope helpers).
   hal::q31_t word_for(double v) const;

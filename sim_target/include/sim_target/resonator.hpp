@@ -94,8 +94,12 @@ class Resonator {
   // and coefficient updates are done once for the n steps. The sink runs
   // inline, so the caller's per-sample work (noise, ADC) overlaps the step's
   // dependency chain.
-  template <class Sink>
-  void step_block(const Drive* drives, std::size_t n, double dt_s, Sink&& sink) {
+  //
+  // kWide: the held-inputs loop on four rows at a time (step_wide()), for a
+  // caller compiled for AVX2 (SimTarget checks the CPU once); the same bits.
+  template <bool kWide = false, class Sink>
+  [[gnu::always_inline]] void step_block(const Drive* drives, std::size_t n, double dt_s,
+                                         Sink&& sink) {
     double rate = 0.0;
     double temp_c = 0.0;
     if (!inputs_held(n, dt_s, rate, temp_c)) {
@@ -107,7 +111,11 @@ class Resonator {
     }
     const HeldCoefficients c = prepare_held(rate, temp_c, dt_s);
     if (kPlainMatchesEigen && c.iso == 0.0 && c.damp == 0.0 && !pickoff_effects_) {
-      step_plain(drives, n, sink);
+      if constexpr (kWide) {
+        step_wide(drives, n, sink);
+      } else {
+        step_plain(drives, n, sink);
+      }
       cursor_steps_ = steps_ - 1;
       return;
     }
@@ -220,6 +228,52 @@ class Resonator {
     steps_ += n;
     u_ << pos[0], pos[1], vel[0], vel[1];
   }
+  // step_plain() on four rows at a time: rows 0-3 of [Phi_rate; Psi_gap]
+  // (x, y, x', y' at once) and rows 4-7, each column's product and sum in
+  // the same order per row as step_plain() and Eigen, so the same bits; the
+  // twelve columns stay in registers (AVX2 has sixteen of four doubles). No
+  // fused multiply-add: AVX2 alone does not enable FMA, so the compiler
+  // cannot contract a product and a sum into one rounding.
+  template <class Sink>
+  [[gnu::always_inline]] void step_wide(const Drive* drives, std::size_t n, Sink& sink) {
+    using v4d = double __attribute__((vector_size(32)));
+    const double* r = rate_gap_.data();  // 8x4, column-major
+    const double* g = gamma_.data();     // 4x2, column-major
+    v4d phi[4];
+    v4d gap[4];
+    for (std::size_t j = 0; j < 4; ++j) {
+      std::memcpy(&phi[j], r + 8 * j, sizeof(v4d));
+      std::memcpy(&gap[j], r + 8 * j + 4, sizeof(v4d));
+    }
+    v4d gx;
+    v4d gy;
+    std::memcpy(&gx, g, sizeof gx);
+    std::memcpy(&gy, g + 4, sizeof gy);
+    const double k_pump = electrodes_.pump_gain_per_s2_v2;
+    const double k_spring = spring_k_;
+    v4d u = {u_(0), u_(1), u_(2), u_(3)};
+    PumpRing pump_ring(*this);
+    for (std::size_t k = 0; k < n; ++k) {
+      sink(k, PickoffOutput{u[0], u[1]});
+      const Drive d = drives[k];
+      const double v2_dc = pump_ring.push(d.pump_v);
+      const double v2 = d.pump_v * d.pump_v;
+      const double c_gap = k_pump * (v2 - v2_dc) + k_spring * v2_dc;
+      const v4d u0 = {u[0], u[0], u[0], u[0]};
+      const v4d u1 = {u[1], u[1], u[1], u[1]};
+      const v4d u2 = {u[2], u[2], u[2], u[2]};
+      const v4d u3 = {u[3], u[3], u[3], u[3]};
+      const v4d rate = ((phi[0] * u0 + phi[1] * u1) + phi[2] * u2) + phi[3] * u3;
+      const v4d pump = ((gap[0] * u0 + gap[1] * u1) + gap[2] * u2) + gap[3] * u3;
+      const v4d fx = {d.forcer_x_v, d.forcer_x_v, d.forcer_x_v, d.forcer_x_v};
+      const v4d fy = {d.forcer_y_v, d.forcer_y_v, d.forcer_y_v, d.forcer_y_v};
+      const v4d cg = {c_gap, c_gap, c_gap, c_gap};
+      u = (rate + (gx * fx + gy * fy)) + cg * pump;
+    }
+    pump_ring.store();
+    steps_ += n;
+    u_ << u[0], u[1], u[2], u[3];
+  }
   // Whether step_block may take its held-inputs path; the rate and the
   // temperature it holds when so.
   bool inputs_held(std::size_t n, double dt_s, double& rate_rad_s, double& temp_c);
@@ -230,6 +284,47 @@ class Resonator {
   };
   HeldCoefficients prepare_held(double rate_rad_s, double temp_c, double dt_s);
   double pump_delayed(double delay_samples) const;
+  // The pump history's position and running sum in locals over a loop of
+  // steps (registers: the caller's stores could alias the members), the
+  // same operations as push_pump(); back into the members by store().
+  struct PumpRing {
+    explicit PumpRing(Resonator& r)
+        : res(r),
+          hist(r.pump_hist_.data()),
+          sq(r.pump_sq_hist_.data()),
+          pos(r.hist_pos_),
+          avg(r.avg_len_),
+          sum(r.pump_sq_sum_),
+          valid(r.pump_sum_valid_) {}
+    [[gnu::always_inline]] double push(double pump_v) {
+      constexpr int kMask = kHistory - 1;
+      pos = (pos + 1) & kMask;
+      const double leaving = sq[(pos - avg) & kMask];
+      hist[pos] = pump_v;
+      sq[pos] = pump_v * pump_v;
+      if (pos == 0 || !valid) [[unlikely]] {
+        store();
+        res.readd_pump_squares();
+        sum = res.pump_sq_sum_;
+        valid = true;
+      } else {
+        sum += sq[pos] - leaving;
+      }
+      return sum / avg;
+    }
+    void store() const {
+      res.hist_pos_ = pos;
+      res.pump_sq_sum_ = sum;
+      res.pump_sum_valid_ = valid;
+    }
+    Resonator& res;
+    double* hist;
+    double* sq;
+    int pos;
+    int avg;
+    double sum;
+    bool valid;
+  };
   double push_pump(double pump_v) {      // records the held pump voltage, returns <V^2>
     constexpr int kMask = kHistory - 1;  // kHistory is a power of two
     hist_pos_ = (hist_pos_ + 1) & kMask;

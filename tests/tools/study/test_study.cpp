@@ -118,6 +118,53 @@ TEST(StudyGrid, MergedPointLinesMustCoverTheGridOnce) {
   std::remove(path.c_str());
 }
 
+// A seed whose parks sit within a degree of one pattern angle: the 4 theta
+// fit cannot separate its mean from its ADB, so the seed gives no ADB, its
+// bias is the parks' plain mean, and the point is not counted as measured.
+TEST(StudyGrid, ADegenerateParkSetGivesNoAdbAndCarriesItsReason) {
+  const Grid g = hrg::study::parse_grid(std::string(kAxes) + "q = [1e6]\n", "g.toml");
+  std::vector<double> spread_rad, narrow_rad, bias_dph;
+  for (int i = 0; i < 8; ++i) {
+    spread_rad.push_back(i * kPi / 16.0);  // two 4 theta turns' worth of spread
+    narrow_rad.push_back((0.3 + 0.002 * i) * kPi / 180.0);
+    // 0.3 deg/h offset, a 4 theta part of 0.2 deg/h and a small alternating scatter
+    bias_dph.push_back(0.3 + 0.2 * std::sin(4.0 * spread_rad.back()) + 0.01 * (i % 2 ? 1 : -1));
+  }
+  const auto spread = hrg::sim_run::fit_bias_4theta(spread_rad, bias_dph);
+  const auto narrow = hrg::sim_run::fit_bias_4theta(narrow_rad, bias_dph);
+  CHECK_FALSE(spread.degenerate());
+  CHECK_TRUE(narrow.degenerate());
+
+  PointResult p;
+  for (int k = 0; k < 3; ++k) {
+    hrg::study::SeedResult s;
+    s.seed = static_cast<uint64_t>(k + 1);
+    s.locked = true;
+    s.comp_applied = true;
+    s.t_converged_s = 100.0;
+    s.t_bias_start_s = 200.0;
+    hrg::study::set_bias_test(spread, k == 2 ? narrow : spread, s);
+    p.seeds.push_back(s);
+  }
+  const auto& odd = p.seeds[2];
+  CHECK_TRUE(odd.comp_parks_degenerate);
+  DOUBLES_EQUAL(-1.0, odd.comp_adb_dph, 0.0);
+  DOUBLES_EQUAL(narrow.park_mean, odd.comp_bias_dph, 1e-12);
+  DOUBLES_EQUAL(0.3, odd.comp_bias_dph, 0.011);
+
+  hrg::study::summarise_point(g, p);
+  DOUBLES_EQUAL(spread.amplitude(), p.comp_adb_dph, 1e-12);  // the two seeds that have an ADB
+  DOUBLES_EQUAL(0.2, p.comp_adb_dph, 0.01);
+  CHECK_FALSE(p.meets_bound);
+  CHECK_EQUAL(1u, p.reasons.size());
+  STRCMP_CONTAINS("no ADB from the bias test", p.reasons[0].c_str());
+  STRCMP_CONTAINS("(seed 3)", p.reasons[0].c_str());
+  STRCMP_CONTAINS("not separable", p.reasons[0].c_str());
+  const std::string line = hrg::study::point_json_line(p);
+  STRCMP_CONTAINS("\"comp_parks_degenerate\": true", line.c_str());
+  STRCMP_CONTAINS("\"comp_adb_dph\": null", line.c_str());
+}
+
 TEST_GROUP(StudySmallGrid){void setup()
                                override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
 }

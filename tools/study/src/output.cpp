@@ -47,8 +47,10 @@ void seed_json(sim_run::JsonWriter& w, const SeedResult& s) {
   w.integer("model_checks_failed", s.model_checks_failed);
   w.number("excitation_off", s.excitation_off);
   w.number("control_drift_mean_dph", s.control_drift_mean_dph);
-  w.number("raw_adb_dph", s.raw_adb_dph);
-  w.number("comp_adb_dph", s.comp_adb_dph);
+  w.number("raw_adb_dph", or_none(s.raw_adb_dph));
+  w.number("comp_adb_dph", or_none(s.comp_adb_dph));
+  w.boolean("raw_parks_degenerate", s.raw_parks_degenerate);
+  w.boolean("comp_parks_degenerate", s.comp_parks_degenerate);
   w.number("raw_bias_dph", s.raw_bias_dph);
   w.number("comp_bias_dph", s.comp_bias_dph);
   w.number("meas_sigma_dph", s.meas_sigma_dph);
@@ -76,8 +78,8 @@ std::string point_json_line(const PointResult& p) {
   w.string("setup_error", p.setup_error);
   w.number("pump_needed_v", p.pump_needed_v);
   w.number("pump_max_v", p.pump_max_v);
-  w.number("raw_adb_dph", p.raw_adb_dph);
-  w.number("comp_adb_dph", p.comp_adb_dph);
+  w.number("raw_adb_dph", or_none(p.raw_adb_dph));
+  w.number("comp_adb_dph", or_none(p.comp_adb_dph));
   w.number("raw_bias_dph", p.raw_bias_dph);
   w.number("comp_bias_dph", p.comp_bias_dph);
   w.number("crb_adb_end_dph", or_none(p.crb_adb_end_dph));

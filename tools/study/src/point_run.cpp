@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "firmware/app/firmware.hpp"
+#include "sim_run/report.hpp"
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 #include "study/point.hpp"
@@ -69,17 +70,24 @@ class ConvergenceProbe {
   SeedResult& out_;
 };
 
-void copy_bias_test(const sim_run::RunResult& r, const sim_run::RunConfig& job, SeedResult& s) {
-  s.bias_fit = r.fit_comp.ok && r.fit_raw.ok;
-  s.t_bias_start_s = job.parks.empty() ? -1.0 : job.parks.front().t_begin_s;
-  s.raw_adb_dph = r.fit_raw.amplitude();
-  s.comp_adb_dph = r.fit_comp.amplitude();
-  s.raw_bias_dph = r.fit_raw.b0;
-  s.comp_bias_dph = r.fit_comp.b0;
-  s.meas_sigma_dph = std::hypot(r.fit_comp.sigma_a, r.fit_comp.sigma_b);
-}
+// A degenerate park set's fit trades its mean against its 4 theta terms: it
+// gives no ADB (-1), and its bias is the parks' plain mean.
+double adb_of(const sim_run::BiasFit& f) { return f.degenerate() ? -1.0 : f.amplitude(); }
+double bias_of(const sim_run::BiasFit& f) { return f.degenerate() ? f.park_mean : f.b0; }
 
 }  // namespace
+
+void set_bias_test(const sim_run::BiasFit& raw, const sim_run::BiasFit& comp, SeedResult& s) {
+  s.bias_fit = comp.ok && raw.ok;
+  s.raw_parks_degenerate = raw.degenerate();
+  s.comp_parks_degenerate = comp.degenerate();
+  s.comp_parks_note = s.comp_parks_degenerate ? sim_run::degenerate_parks_note(comp) : "";
+  s.raw_adb_dph = adb_of(raw);
+  s.comp_adb_dph = adb_of(comp);
+  s.raw_bias_dph = bias_of(raw);
+  s.comp_bias_dph = bias_of(comp);
+  s.meas_sigma_dph = std::hypot(comp.sigma_a, comp.sigma_b);
+}
 
 SeedResult run_seed(const Grid& grid, const PointSpec& spec, int seed_index) {
   const sim_run::RunConfig job = point_job(grid, spec, seed_index);
@@ -98,7 +106,8 @@ SeedResult run_seed(const Grid& grid, const PointSpec& spec, int seed_index) {
   s.model_checks_failed = r.model_checks_failed;
   s.excitation_off = r.excitation_off_fraction;
   s.control_drift_mean_dph = r.control_drift_mean_dph;
-  copy_bias_test(r, job, s);
+  s.t_bias_start_s = job.parks.empty() ? -1.0 : job.parks.front().t_begin_s;
+  set_bias_test(r.fit_raw, r.fit_comp, s);
   return s;
 }
 

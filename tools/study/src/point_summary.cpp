@@ -28,6 +28,19 @@ double mean_of(const std::vector<SeedResult>& seeds, Get get) {
   return seeds.empty() ? 0.0 : sum / static_cast<double>(seeds.size());
 }
 
+// Mean of a figure over the seeds that have one (>= 0); -1 when none has.
+template <class Get>
+double mean_measured(const std::vector<SeedResult>& seeds, Get get) {
+  double sum = 0.0;
+  int n = 0;
+  for (const SeedResult& s : seeds) {
+    if (get(s) < 0.0) continue;
+    sum += get(s);
+    ++n;
+  }
+  return n > 0 ? sum / n : -1.0;
+}
+
 // Mean over seeds sample by sample; a negative entry (no bound yet) is left
 // out, and a sample none of the seeds has is -1.
 std::vector<double> mean_series(const std::vector<SeedResult>& seeds,
@@ -92,6 +105,8 @@ void explain_miss(const Grid& grid, PointResult& p) {
     const std::string seed = " (seed " + std::to_string(s.seed) + ")";
     if (!s.locked) {
       p.reasons.push_back("does not lock: never reached operate" + seed);
+    } else if (s.comp_parks_degenerate) {
+      p.reasons.push_back("no ADB from the bias test: " + s.comp_parks_note + seed);
     } else if (!s.bias_fit) {
       p.reasons.push_back(fmt("no bias test fits in the run length %.0f s", grid.duration_s) +
                           seed);
@@ -115,8 +130,8 @@ void explain_miss(const Grid& grid, PointResult& p) {
 
 void summarise_point(const Grid& grid, PointResult& p) {
   const auto& s = p.seeds;
-  p.raw_adb_dph = mean_of(s, [](const SeedResult& r) { return r.raw_adb_dph; });
-  p.comp_adb_dph = mean_of(s, [](const SeedResult& r) { return r.comp_adb_dph; });
+  p.raw_adb_dph = mean_measured(s, [](const SeedResult& r) { return r.raw_adb_dph; });
+  p.comp_adb_dph = mean_measured(s, [](const SeedResult& r) { return r.comp_adb_dph; });
   p.raw_bias_dph = mean_of(s, [](const SeedResult& r) { return r.raw_bias_dph; });
   p.comp_bias_dph = mean_of(s, [](const SeedResult& r) { return r.comp_bias_dph; });
   p.meas_sigma_dph = mean_of(s, [](const SeedResult& r) { return r.meas_sigma_dph; });
@@ -132,13 +147,15 @@ void summarise_point(const Grid& grid, PointResult& p) {
       mean_of(s, [](const SeedResult& r) { return r.control_drift_mean_dph; });
   const double crb = p.crb_adb_end_dph > 0.0 ? p.crb_adb_end_dph : 0.0;
   p.predicted_adb_dph = std::hypot(crb, p.meas_sigma_dph);
-  p.ratio = p.predicted_adb_dph > 0.0 ? p.comp_adb_dph / p.predicted_adb_dph : -1.0;
+  p.ratio = p.predicted_adb_dph > 0.0 && p.comp_adb_dph >= 0.0
+                ? p.comp_adb_dph / p.predicted_adb_dph
+                : -1.0;
   // A bias test counts only where every seed measured it with its model
   // converged and in force.
   bool measured = p.setup_error.empty() && !s.empty();
   for (const SeedResult& r : s)
-    measured = measured && r.locked && r.bias_fit && r.comp_applied && r.t_converged_s >= 0.0 &&
-               r.t_converged_s <= r.t_bias_start_s;
+    measured = measured && r.locked && r.bias_fit && !r.comp_parks_degenerate && r.comp_applied &&
+               r.t_converged_s >= 0.0 && r.t_converged_s <= r.t_bias_start_s;
   p.meets_bound = measured && p.predicted_adb_dph > 0.0 && p.ratio <= kBoundFactor;
   p.reasons.clear();
   if (!p.meets_bound) explain_miss(grid, p);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sim_run/analysis.hpp"
 #include "study/grid.hpp"
 
 namespace hrg::study {
@@ -29,9 +30,13 @@ struct SeedResult {
   uint32_t model_checks_failed = 0;
   double excitation_off = 0;          // fraction of the run
   double control_drift_mean_dph = 0;  // mean D_Phi/K the firmware added over the valid output
-  // The parked-angle bias test (IEEE 1431 style), raw and compensated.
+  // The parked-angle bias test (IEEE 1431 style), raw and compensated. A
+  // park set too narrow for the 4 theta fit (sim_run::BiasFit::degenerate)
+  // has no ADB (-1) and its bias is the plain mean over the parks.
   double raw_adb_dph = 0, comp_adb_dph = 0, raw_bias_dph = 0, comp_bias_dph = 0;
-  double meas_sigma_dph = 0;  // the compensated fit's own 1-sigma on the ADB (bias test noise)
+  bool raw_parks_degenerate = false, comp_parks_degenerate = false;
+  std::string comp_parks_note;  // the compensated park set's geometry when degenerate
+  double meas_sigma_dph = 0;    // the compensated fit's own 1-sigma on the ADB (bias test noise)
   // Sampled every Grid::sample_every_s: the model in force against the truth
   // (4 theta amplitude of the resonator drift it leaves, deg/h) and the
   // Cramer-Rao bound of that amplitude for the windows taken (RMS, deg/h).
@@ -44,7 +49,7 @@ struct PointResult {
   double pump_needed_v = 0;  // pump amplitude that holds the wave on the most damped axis
   double pump_max_v = 0;     // the chain's limit
   std::vector<SeedResult> seeds;
-  // Means over seeds.
+  // Means over seeds; an ADB over the seeds that have one (-1: none has).
   double raw_adb_dph = 0, comp_adb_dph = 0, raw_bias_dph = 0, comp_bias_dph = 0;
   double crb_adb_end_dph = 0;    // Cramer-Rao bound of the model's ADB at the run's end
   double model_adb_end_dph = 0;  // the ADB the model in force leaves at the end (truth)
@@ -62,6 +67,10 @@ struct PointResult {
   std::array<double, 3> t_reach_s{-1, -1, -1};
   std::array<double, 3> crb_at_reach_dph{-1, -1, -1};
 };
+
+// The parked-angle bias test's figures of a run from its raw and
+// compensated 4 theta fits (a degenerate park set: no ADB, the plain mean).
+void set_bias_test(const sim_run::BiasFit& raw, const sim_run::BiasFit& comp, SeedResult& s);
 
 // Runs seed `seed_index` of the point (the firmware on the simulated target).
 // Throws std::invalid_argument when the point cannot be set up.
