@@ -128,8 +128,9 @@ struct Chosen {
   // Set by weigh_findings(): value, 1-sigma (catalogue unit) and the share of
   // the baseline's misfit it removes given everything else (-1: edges).
   double value = 0.0, sigma = 0.0, fraction = 0.0;
-  bool unique_checked = false;  // fraction from a drop-one refit
+  bool unique_checked = false;  // removed_chi2 from a drop-one refit
   double unique_dchi = -1.0;    // chi^2 (whitened) it removes given everything else
+  double removed_chi2 = 0.0;    // chi^2 (unwhitened) it removes given everything else
 };
 
 // One candidate added to the current model.
@@ -169,6 +170,9 @@ class Auditor {
   double heldout_rms(const Mask& mask, const Params& start);
   double rms_v(const State& s) const;
   double free_chi2(const State& s) const;  // chi^2 of the free-decay samples alone
+  // chi^2 of the excitation-segment observations over their count (0: fewer
+  // than kBalanceMinSegments).
+  double forced_ratio(const State& s) const;
   double slow_noise_factor(const State& s) const;
 
   // Steps of run(), in order.
@@ -259,6 +263,15 @@ double Auditor::free_chi2(const State& s) const {
   for (std::size_t i = 0; i < n && i < s.res.size(); ++i)
     acc += s.res[i] * s.res[i];
   return acc;
+}
+
+double Auditor::forced_ratio(const State& s) const {
+  const auto n0 = static_cast<std::size_t>(n_free_res());
+  if (s.res.size() < n0 + kBalanceMinSegments) return 0.0;  // too few to tell
+  double acc = 0.0;
+  for (std::size_t i = n0; i < s.res.size(); ++i)
+    acc += s.res[i] * s.res[i];
+  return acc / static_cast<double>(s.res.size() - n0);
 }
 
 double Auditor::rms_v(const State& s) const {
@@ -858,7 +871,6 @@ void Auditor::test_thermal_vs_drift(const State& full, std::vector<Chosen>& chos
 // so that two effects that can stand for each other do not both leave.
 State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResult& out) {
   if (!opt_.ar_whitening && chosen.size() < 2 && out.description.terms.empty()) return full;
-  const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
   for (;;) {
     std::size_t worst = chosen.size();
     double worst_dbic = 1e300;
@@ -870,7 +882,7 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
           fit_state(with_effect(full.mask, e, false), without_effect(full.fit.p, e), false);
       const double unique_dbic = delta_bic(without, full, n_params_of(e));
       chosen[k].unique_dchi = delta_chi2(without, full);
-      chosen[k].fraction = std::max(0.0, without.fit.chi2 - full.fit.chi2) / excess0;
+      chosen[k].removed_chi2 = std::max(0.0, without.fit.chi2 - full.fit.chi2);
       chosen[k].unique_checked = true;
       if (unique_dbic < worst_dbic)
         worst_dbic = unique_dbic, worst = k, worst_without = std::move(without);
@@ -885,14 +897,42 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
   }
 }
 
+// Effects seen only on the excitation segments (the gap harmonics: the
+// pump's balance and drift). Those segments are modelled without the
+// firmware's loops, which act on what the pickoff map makes of the wave: a
+// pickoff phase mismatch of 1 deg leaves a 4 theta pattern in the pump that
+// reads as eps_p -0.0084 (seed 4 of the default scenario), whether or not
+// the free decays leave structure.
+bool seen_only_on_excitation(Effect e) { return e == Effect::gap_harmonics; }
+
+// The rule weigh_findings() applies, in words, with the run's thresholds.
+std::string acceptance_rule_text(const AuditOptions& o) {
+  char rule[768];
+  std::snprintf(rule, sizeof rule,
+                "a finding stands at least %.3g of its standard deviations from zero and removes "
+                "at least %.3g of the baseline's misfit beyond the noise (explains_fraction) "
+                "when structure is left (a description, residual variance above %.3g x the "
+                "noise, or the excitation segments' observations above %.3g x their noise), and "
+                "always when it is seen only on the excitation segments (gap_harmonics); drive "
+                "feedthrough, seen on the switching edges, is not claimed with structure left",
+                o.min_significance, o.min_explains_fraction, o.unexplained_ratio,
+                o.unexplained_ratio);
+  return rule;
+}
+
 // A finding must carry its own weight: after drop_unneeded() it must stand
-// min_significance of its standard deviations away from zero and, with
-// structure left, remove at least min_explains_fraction of the baseline's
-// misfit beyond the noise (given everything else); otherwise it is an
-// alternative.
+// min_significance of its standard deviations away from zero and remove at
+// least min_explains_fraction of the baseline's misfit beyond the noise
+// (given everything else) when structure is left (a description, residual
+// variance above the noise, or the excitation segments' observations above
+// their noise after the final model: a pull no catalogue term holds) and,
+// for an effect seen only on the excitation segments, always. Otherwise it
+// is an alternative.
 void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                              bool structure_left, AuditResult& out) {
   const double excess0 = std::max(1.0, baseline_chi2_ - baseline_n_);
+  const bool forced_left = forced_ratio(full) > opt_.unexplained_ratio;
+  out.acceptance_rule = acceptance_rule_text(opt_);
   std::vector<Chosen> kept;
   for (auto& c : chosen) {
     const int pi = param_of(c.effect);
@@ -908,14 +948,20 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
         // the square root of the chi^2 the effect removes given the rest.
         sigma = std::max(sigma, std::abs(value) / std::sqrt(std::max(c.unique_dchi, 1e-12)));
       }
-      if (!c.unique_checked) c.fraction = std::max(0.0, c.dchi) / excess0;
+      if (!c.unique_checked) c.removed_chi2 = std::max(0.0, c.dchi);
+      c.fraction = c.removed_chi2 / excess0;
     } else {
       c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
     }
+    const bool small = pi >= 0 && c.fraction < opt_.min_explains_fraction;
     if (!(std::abs(value) >= opt_.min_significance * sigma)) {
       why = "not significantly away from zero";
-    } else if (structure_left && (pi < 0 || c.fraction < opt_.min_explains_fraction)) {
+    } else if ((structure_left && pi < 0) || (small && (structure_left || forced_left))) {
       why = "takes up only part of structure that stays unexplained; not claimed";
+    } else if (small && seen_only_on_excitation(c.effect)) {
+      why =
+          "seen only on the excitation segments and removes less than its share of the "
+          "misfit; not claimed";
     }
     if (why != nullptr) {
       out.alternatives.push_back({c.effect, value, c.dbic, why});

@@ -110,6 +110,7 @@ std::string to_json(const AuditResult& r) {
   }
   if (!r.unexplained_note.empty()) j += ",\n  \"unexplained\": " + str(r.unexplained_note);
   if (!r.description.terms.empty()) j += ",\n  \"description\": " + description_json(r.description);
+  j += ",\n  \"acceptance_rule\": " + str(r.acceptance_rule);
   j += ",\n  \"candidates\": " + json_list(r.candidates, candidate_json);
   j += ",\n  \"notes\": [";
   for (std::size_t i = 0; i < r.notes.size(); ++i)

@@ -51,8 +51,9 @@ struct AuditOptions {
   // remaining structure is called unexplained.
   double unexplained_ratio = 1.5;
   // A catalogue finding must stand this many of its standard deviations away
-  // from zero and, with structure left, remove at least this share of the
-  // baseline's misfit.
+  // from zero and, with structure left (the excitation segments' included)
+  // and always for an effect seen only on the excitation segments, remove at
+  // least this share of the baseline's misfit.
   double min_significance = 5.0;
   double min_explains_fraction = 0.2;
   // Evidence for a generic description term (delta BIC): a search over many
@@ -166,6 +167,8 @@ struct AuditResult {
   std::string ambiguity_experiment;
   std::string unexplained_note;
   std::vector<std::string> notes;  // gaps, skipped tests, ...
+  // The rule a finding met (README step 7), with this run's thresholds.
+  std::string acceptance_rule;
   int free_segments = 0;
   int forced_segments = 0;
   int heldout_segments = 0;
