@@ -145,12 +145,12 @@ double ControlDriftEstimator::used_d_phi_rad_s() const {
 
 void PumpDriftEstimator::fold_segment() {
   if (seg_blocks_ >= 3) {
-    Mat4 c = seg_s_ - seg_sum_ * seg_sum_.transpose() / seg_blocks_;
+    MatR c = seg_s_ - seg_sum_ * seg_sum_.transpose() / seg_blocks_;
     double decay = 1.0;
     if (config_.forgetting_time_s > 0 && have_fold_)
       decay = std::exp(-(t_last_s_ - t_last_fold_s_) / config_.forgetting_time_s);
     m_ = decay * m_ + c * static_cast<double>(config_.block_samples);
-    for (Mat4& b : batch_)
+    for (MatR& b : batch_)
       b *= decay;
     batch_[segments_ % kBatches] += c * static_cast<double>(config_.block_samples);
     ++segments_;
@@ -169,10 +169,38 @@ void PumpDriftEstimator::fold_segment() {
 
 void PumpDriftEstimator::restart() { fold_segment(); }
 
+void PumpDriftEstimator::set_model(const ParamVector& p, const ParamMatrix& covariance) {
+  p_ = p;
+  p_cov_ = covariance;
+  if (have_fold_) refresh_fit();
+}
+
+Eigen::Matrix<double, 2, kParams> PumpDriftEstimator::model_shift() const {
+  // A model off by dp adds dp' J to every y, and the fit (b0, b1, b2) moves
+  // by N^-1 [sum I J'] dp (the sums of the rows, m_'s regressor-J block).
+  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  const Eigen::Vector3d s = n.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::Matrix3d a = s.asDiagonal() * n * s.asDiagonal();
+  const Eigen::Matrix<double, 3, kParams> x = m_.block<3, kParams>(0, 3);
+  const Eigen::Matrix<double, 3, kParams> shift =
+      s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * x);
+  return shift.bottomRows<2>();
+}
+
+PumpDriftEstimator::Mat4 PumpDriftEstimator::with_model(const MatR& m) const {
+  // y = L + p' J: the row (I0, I1, I2, y) is t r with t = [I3 0 0; 0 p' 1].
+  Eigen::Matrix<double, 4, kRow> t = Eigen::Matrix<double, 4, kRow>::Zero();
+  t.topLeftCorner<3, 3>().setIdentity();
+  t.block<1, kParams>(3, 3) = p_.transpose();
+  t(3, kRow - 1) = 1.0;
+  return t * m * t.transpose();
+}
+
 bool PumpDriftEstimator::add_sample(const Sample& s) {
   if (!std::isfinite(s.t_s) || !std::isfinite(s.a_A_v) || !(s.a_A_v > 0) ||
       !std::isfinite(s.a_B_v) || !std::isfinite(s.theta_A_rad) || !std::isfinite(s.pump_v) ||
-      !(s.pump_v > 0) || !std::isfinite(s.pump_phase_error_rad) ||
+      !(s.pump_v >= 0) || !std::isfinite(s.pump_phase_error_rad) ||
+      !std::isfinite(s.damping_scale) ||
       (started_ && !(s.t_s > t_last_s_ && s.t_s - t_last_s_ <= config_.max_sample_gap_s))) {
     fold_segment();
     return false;
@@ -181,11 +209,12 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
   const double s4 = std::sin(4.0 * s.theta_A_rad);
   const double w = s.pump_v * s.pump_v * std::cos(s.pump_phase_error_rad);
   w_last_ = w;
-  const double dnu = p_(kDnuC) * c4 + p_(kDnuS) * s4;
-  const double g = p_(kDwC) * s4 - p_(kDwS) * c4;
-  // Integrands: the three pump regressors and the known decay rate (the
-  // damping at this sample's scale).
-  const Vec4 h(w, w * c4, w * s4, s.damping_scale * (p_(kNu) + dnu) + g * s.a_B_v / s.a_A_v);
+  const double k = s.damping_scale;
+  const double q = s.a_B_v / s.a_A_v;
+  // Integrands: the three pump regressors and the known decay rate's five
+  // (k (nu + dnu_C c4 + dnu_S s4) + (dw_C s4 - dw_S c4) q = p' J').
+  VecH h;
+  h << w, w * c4, w * s4, k, k * c4, k * s4, q * s4, -q * c4;
   const double ln_a = std::log(s.a_A_v);
   if (!started_) {
     started_ = true;
@@ -197,10 +226,10 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
     t_last_s_ = s.t_s;
   }
   h_prev_ = h;
-  // Row: regressors I0..I2 and y = ln a - ln a0 + int known rate.
-  block_ += Vec4(z_(0), z_(1), z_(2), ln_a - ln_a0_ + z_(3));
+  block_.head<kRow - 1>() += z_;
+  block_(kRow - 1) += ln_a - ln_a0_;
   if (++in_block_ == config_.block_samples) {
-    const Vec4 r = block_ / in_block_;
+    const VecR r = block_ / in_block_;
     seg_s_ += r * r.transpose();
     seg_sum_ += r;
     ++seg_blocks_;
@@ -212,14 +241,17 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
 }
 
 void PumpDriftEstimator::refresh_fit() {
-  const Eigen::Matrix3d n = m_.topLeftCorner<3, 3>();
+  const Mat4 m = with_model(m_);
+  const Eigen::Matrix3d n = m.topLeftCorner<3, 3>();
   kappa_2_ = conditioning_of<3>(n).kappa_2;
   coefficients_.setZero();
+  gap_sigmas_ = 0.0;
   if (!valid()) return;
-  const Eigen::Vector3d b = m_.topRightCorner<3, 1>();
+  const Eigen::Vector3d b = m.topRightCorner<3, 1>();
   const Eigen::Vector3d s = n.diagonal().cwiseSqrt().cwiseInverse();
   const Eigen::Matrix3d a = s.asDiagonal() * n * s.asDiagonal();
   coefficients_ = s.asDiagonal() * a.ldlt().solve(s.asDiagonal() * b);
+  gap_sigmas_ = gap_sigmas_from(Eigen::Vector2d::Zero());
 }
 
 double PumpDriftEstimator::kappa_2() const { return kappa_2_; }
@@ -260,24 +292,28 @@ bool gap_harmonic(const Eigen::Matrix4d& m, Eigen::Vector2d& g) {
 }
 }  // namespace
 
-double PumpDriftEstimator::gap_sigmas() const { return gap_sigmas_from(Eigen::Vector2d::Zero()); }
+double PumpDriftEstimator::gap_sigmas() const { return gap_sigmas_; }
 
 double PumpDriftEstimator::gap_sigmas_from(const Eigen::Vector2d& g0) const {
   if (!valid() || segments_ < 2 * kBatches) return 0.0;
   Eigen::Vector2d g;
-  if (!gap_harmonic(m_, g)) return 0.0;
+  if (!gap_harmonic(with_model(m_), g)) return 0.0;
   std::array<Eigen::Vector2d, kBatches> gb;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (int j = 0; j < kBatches; ++j) {
-    if (!gap_harmonic(batch_[static_cast<std::size_t>(j)], gb[static_cast<std::size_t>(j)]))
+    if (!gap_harmonic(with_model(batch_[static_cast<std::size_t>(j)]),
+                      gb[static_cast<std::size_t>(j)]))
       return 0.0;
     mean += gb[static_cast<std::size_t>(j)] / kBatches;
   }
-  // Covariance of the full fit ~ that of the mean of the batch fits.
+  // Covariance of the full fit ~ that of the mean of the batch fits, plus
+  // what the model's own uncertainty moves the fit by (model_shift()).
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
   for (const Eigen::Vector2d& x : gb)
     cov += (x - mean) * (x - mean).transpose();
   cov /= static_cast<double>(kBatches) * (kBatches - 1);
+  const Eigen::Matrix<double, 2, kParams> a = model_shift();
+  cov += a * p_cov_ * a.transpose();
   const Eigen::Vector2d dg = g - g0;
   const double m2 = dg.dot(cov.ldlt().solve(dg));
   return m2 > 0.0 && std::isfinite(m2) ? std::sqrt(m2) : 0.0;

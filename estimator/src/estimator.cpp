@@ -54,7 +54,7 @@ Solution Estimator::solve_and_accept() {
     model_ = last_.p;
     has_model_ = true;
     control_.set_model(last_.p);
-    pump_.set_model(last_.p);
+    pump_.set_model(last_.p, last_.covariance);
   }
   return last_;
 }

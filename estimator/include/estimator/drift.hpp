@@ -180,6 +180,18 @@ class ControlDriftEstimator {
 // excitation-on time (segments end at a window or every segment_s), and
 // block means of block_samples samples as rows. Then
 //   D_Phi(th) = w (b2 cos4th - b1 sin4th).
+// The known rate is linear in the model p: the rows keep its five integrals
+// (int k, int k cos4th, int k sin4th, int q sin4th, -int q cos4th; k the
+// damping scale, q = a_B/a_A) apart, and every fit is made with the model in
+// force now. Folding y with the model of its own time instead would keep the
+// early models' errors (dnu of a few windows) in the fit for good, and
+// anisotropic damping the model has since learnt reads as a gap harmonic:
+// an error dnu_err in (dnu_C, dnu_S) shows as (b1, b2) = -dnu_err / w.
+// The AGC at its lower limit (pump_v 0: the pump applies no force) is a row
+// like any other: cutting the segment there would keep only the stretches
+// where the amplitude noise did not push the AGC to zero, which depends on
+// the angle through the damping the AGC balances (a false gap harmonic of
+// 0.03 at Q 2e7, dQ/Q 0.3, where the AGC sits at zero a third of the time).
 // Context: control-rate task; no heap.
 class PumpDriftEstimator {
  public:
@@ -197,22 +209,26 @@ class PumpDriftEstimator {
     // harmonic of 1e-2 drifts by ~10 deg/h. 0: always used.
     double min_gap = 0.0;
     // ... and only when the gap harmonic (b1, b2) stands this many of its own
-    // standard errors from zero (gap_sigmas()): a resonator whose pump
-    // effort is small (high Q) leaves a fitted gap of 1e-2 from noise and
-    // from the resonator model's early errors, which the fit takes for a gap
-    // until the model has converged. Measured with an ideal electrode: up
-    // to 5.9 (Q 2e7, at 160 s of the default run); with eps_p 0.02, eps_q
-    // 0.01 above 6.5 from 230 s on. 0: not checked.
+    // standard errors from zero (gap_sigmas(), the model's uncertainty
+    // included): the resonator model's error reads as a gap of
+    // 2 |dnu_err| / (b0 w) until the model has converged. Measured with an
+    // ideal electrode (1800 s runs, Q 1e6 ... 2e7, dQ/Q 0.01 ... 0.3): at
+    // most 3.4 at the end. 0: not checked.
     double min_gap_sigmas = 6.5;
   };
   using Sample = ControlDriftEstimator::Sample;
 
-  PumpDriftEstimator() { batch_.fill(Mat4::Zero()); }
-  explicit PumpDriftEstimator(const Config& c) : config_(c) { batch_.fill(Mat4::Zero()); }
+  PumpDriftEstimator() { batch_.fill(MatR::Zero()); }
+  explicit PumpDriftEstimator(const Config& c) : config_(c) { batch_.fill(MatR::Zero()); }
 
-  void set_model(const ParamVector& p) { p_ = p; }
-  // One control-rate sample with the excitation on (pump_v > 0). Bad input
-  // ends the segment (folding what it holds) and returns false.
+  // The model every fit uses from now on (all folded rows included), and its
+  // covariance (the identification's): the gap harmonic's uncertainty
+  // includes what the model's own error moves the fit by, an error in
+  // (dnu_C, dnu_S) reading as a gap of 2 |dnu_err| / (b0 w).
+  void set_model(const ParamVector& p, const ParamMatrix& covariance = ParamMatrix::Zero());
+  // One control-rate sample with the excitation on (pump_v >= 0; 0 when the
+  // AGC is at its lower limit). Bad input ends the segment (folding what it
+  // holds) and returns false.
   bool add_sample(const Sample& s);
   // Ends the present segment (call when a free-decay window starts).
   void restart();
@@ -228,11 +244,12 @@ class PumpDriftEstimator {
   // The fitted gap harmonic |eps| = 2 |(b1, b2)| / b0; 0 before valid().
   double gap() const;
   // Significance of the gap harmonic: sqrt(b' C^-1 b) for b = (b1, b2) and
-  // C their covariance, from the scatter of kBatches fits over interleaved
+  // C their covariance: the scatter of kBatches fits over interleaved
   // segments (batch means: the rows of a segment are running integrals, so
   // their residuals are correlated and the fit's own residual would
-  // understate it by ~10x). 0 before valid() or while a batch fit is
-  // singular.
+  // understate it by ~10x), plus the model's covariance carried through the
+  // fit (the scatter cannot see it: every batch shares the model). 0 before
+  // valid() or while a batch fit is singular.
   double gap_sigmas() const;
   // The same significance for (b1, b2) - g0: how far the fit stands from a
   // gap harmonic given elsewhere (a calibration's, as b0 (eps_p, eps_q)/2).
@@ -245,18 +262,28 @@ class PumpDriftEstimator {
   }
 
  private:
-  using Vec4 = Eigen::Matrix<double, 4, 1>;
+  // A row: the pump regressors I0..I2, the known rate's integrals J0..J4
+  // (model-free) and L = ln a - ln a0. y = L + p' J for the model p.
+  static constexpr int kRow = 3 + kParams + 1;
+  using VecR = Eigen::Matrix<double, kRow, 1>;
+  using MatR = Eigen::Matrix<double, kRow, kRow>;
+  using VecH = Eigen::Matrix<double, kRow - 1, 1>;
   using Mat4 = Eigen::Matrix<double, 4, 4>;
   void fold_segment();
-  // The fit's derived figures, recomputed only when m_ changes (a fold): the
-  // control-rate task asks for them every sample and an eigen-solve each time
-  // cost more than the rest of the estimator.
+  // The sums of the rows referred to the model p_: [N b; b' yy] of (I0..I2, y).
+  Mat4 with_model(const MatR& m) const;
+  // d(b1, b2)/dp: how an error in the model moves the gap harmonic.
+  Eigen::Matrix<double, 2, kParams> model_shift() const;
+  // The fit's derived figures, recomputed only when m_ or the model changes:
+  // the control-rate task asks for them every sample and an eigen-solve each
+  // time cost more than the rest of the estimator.
   void refresh_fit();
 
   Config config_{};
   ParamVector p_ = ParamVector::Zero();
-  Mat4 m_ = Mat4::Zero();             // [N b; b' yy] over folded segments
-  std::array<Mat4, kBatches> batch_;  // the same sums over segments n, n + kBatches, ...
+  ParamMatrix p_cov_ = ParamMatrix::Zero();
+  MatR m_ = MatR::Zero();             // sum of r r' (per segment, centred) over folded segments
+  std::array<MatR, kBatches> batch_;  // the same sums over segments n, n + kBatches, ...
   uint32_t segments_{0};              // segments folded
   double fit_s_{0};
   double t_last_fold_s_{0};
@@ -266,17 +293,19 @@ class PumpDriftEstimator {
   double t0_s_{0};
   double t_last_s_{0};
   double ln_a0_{0};
-  Vec4 z_{Vec4::Zero()};       // integrals I0, I1, I2 and y
-  Vec4 h_prev_{Vec4::Zero()};  // integrands at the previous sample (w, w c4, w s4, known rate)
-  Vec4 block_{Vec4::Zero()};
+  VecH z_{VecH::Zero()};       // integrals I0..I2, J0..J4
+  VecH h_prev_{VecH::Zero()};  // their integrands at the previous sample
+  VecR block_{VecR::Zero()};
   int in_block_{0};
-  Mat4 seg_s_{Mat4::Zero()};
-  Vec4 seg_sum_{Vec4::Zero()};
+  MatR seg_s_{MatR::Zero()};
+  VecR seg_sum_{VecR::Zero()};
   int seg_blocks_{0};
   double w_last_{0};
-  // refresh_fit(): kappa_2 of m_'s 3x3 and the coefficients (zero until valid).
+  // refresh_fit(): kappa_2 of m_'s 3x3, the coefficients and gap_sigmas()
+  // (zero until valid).
   double kappa_2_{std::numeric_limits<double>::infinity()};
   Eigen::Vector3d coefficients_{Eigen::Vector3d::Zero()};
+  double gap_sigmas_{0};
 };
 
 }  // namespace hrg::est
