@@ -312,6 +312,7 @@ void add_edge(const Rows& r, const Run& fr, std::size_t seg_index, bool at_start
   e.free_segment = seg_index;
   e.at_start = at_start;
   const std::size_t skip = pump_off_rows_at_edge(r, fr, at_start);
+  e.pump_off_rows = skip;
   const std::size_t run_rows = fr.last - fr.first + 1 - skip;
   auto row_at = [&](std::size_t j) { return at_start ? fr.last - skip - j : fr.first + skip + j; };
   const std::size_t m = std::min<std::size_t>(kEdgeRows, run_rows);
@@ -323,8 +324,10 @@ void add_edge(const Rows& r, const Run& fr, std::size_t seg_index, bool at_start
     v += r.pump ? std::abs((*r.pump)[row]) / static_cast<double>(m) : 1.0 / static_cast<double>(m);
   }
   e.pump_v = v;
-  for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j)
+  for (std::size_t j = m; j < std::min(run_rows, m + kSlopeRows); ++j) {
     e.slope_rows.push_back(row_at(j));
+    if (r.pump) e.slope_pump_v.push_back(std::abs((*r.pump)[row_at(j)]));
+  }
   if (m >= 4) d.edges.push_back(e);
 }
 

@@ -68,6 +68,8 @@ struct Edge {
   std::vector<std::size_t> slope_rows;
   double pump_v = 0.0;                // mean |pump_v| over forced_rows (1 without the column)
   std::vector<double> forced_pump_v;  // |pump_v| of each forced row (empty without the column)
+  std::vector<double> slope_pump_v;   // |pump_v| of each slope row (empty without the column)
+  std::size_t pump_off_rows = 0;      // excitation rows at the edge whose pump was already off
 };
 
 struct Dataset {

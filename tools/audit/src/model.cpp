@@ -337,7 +337,7 @@ void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vect
 
 std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p, std::size_t seg,
                                               const std::vector<std::size_t>& rows,
-                                              double* wave_phase_rad) {
+                                              double* wave_phase_rad, double* theta_rad) {
   const FreeSegment& s = d.free[seg];
   std::vector<Mat2> g;
   segment_operators(d, p, s, g);
@@ -362,12 +362,14 @@ std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p,
     const Mat2 e = expm2(dynamics(p, d, inputs_of(ref)), t - ref.t_s);
     const cplx zx = e[0] * zr[0] + e[1] * zr[1];
     const cplx zy = e[2] * zr[0] + e[3] * zr[1];
-    if (i == 0 && wave_phase_rad) {
+    if (i == 0 && (wave_phase_rad || theta_rad)) {
       // Phase of the A wave with theta_A = atan2(S, R)/4 in (-pi/4, pi/4]: the
       // usual convention, so a drive that follows the wave keeps its sign.
       const double th =
           dsp::wave_variables<double>({zx.real(), -zx.imag(), zy.real(), -zy.imag()}).theta_A_rad;
-      *wave_phase_rad = std::arg(zx * std::cos(2.0 * th) + zy * std::sin(2.0 * th));
+      if (wave_phase_rad)
+        *wave_phase_rad = std::arg(zx * std::cos(2.0 * th) + zy * std::sin(2.0 * th));
+      if (theta_rad) *theta_rad = th;
     }
     const cplx rot = std::polar(1.0, d.frame_phase_rad[rows[i]]);
     out.push_back({c[0] * zx + c[1] * zy + cplx(p[kGOffXRe], p[kGOffXIm]) * rot,

@@ -117,9 +117,11 @@ using Mat2 = std::array<cplx, 4>;  // row-major
 Mat2 expm2(const Mat2& a, double t);
 
 // The model's measured envelopes at row times `rows` of free segment `seg`
-// (extrapolated with the segment's own dynamics and fitted initial state).
+// (extrapolated with the segment's own dynamics and fitted initial state),
+// and at the first of them the A wave's phase and pattern angle theta_A in
+// (-pi/4, pi/4] (each where asked for).
 std::vector<std::array<cplx, 2>> predict_rows(const Dataset& d, const Params& p, std::size_t seg,
                                               const std::vector<std::size_t>& rows,
-                                              double* wave_phase_rad);
+                                              double* wave_phase_rad, double* theta_rad = nullptr);
 
 }  // namespace hrg::audit::detail

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <optional>
 
 #include <Eigen/Dense>
 
@@ -56,17 +57,83 @@ struct EdgeJump {
   double var = 0.0;      // noise variance of each real component of j before projection, V^2
   cplx phasor;           // e^{i phi} of the wave at the edge
   double pump_v = 0.0;
+  // The pattern angle stands clear of the branch cut of theta_A (+-pi/4),
+  // where the wave phase, and with it the pump's, turns by pi: the producer's
+  // own measured angle then takes the same branch as the model's.
+  bool sign_known = true;
 };
+
+// Least distance of the pattern angle from the branch cut of theta_A for an
+// edge's sign to follow the wave phase convention: the firmware takes the
+// pump's phase from its own measured angle, block by block, which differs
+// from the model's at the edge by the rows between them (the table turns the
+// pattern by up to 0.15 deg a row), the feedthrough's own pull on the measured
+// angle (~0.5 deg at 1e-3 V/V and 10 V of pump) and the pickoff errors.
+constexpr double kBranchMarginRad = 2.0 * kPi / 180.0;
 
 // Least share of an edge's mean pump that its fitted pump at the edge keeps.
 constexpr double kMinEdgePumpShare = 0.25;
+// Most excitation rows with the pump already off before a switch-off that
+// still count as that switch-off: a producer that marks a row free only once
+// its whole averaging span is leaves a row or two. More, and the pump was
+// switched off inside the excitation (an amplitude loop at its lower limit)
+// while the forcers still acted: the edge is then neither the pump's switching
+// instant nor the start of a free decay, and the free model extrapolated
+// back over those rows is no reference for the jump.
+constexpr std::size_t kMaxPumpOffRows = 2;
+
+// Slope per pickoff of a straight line through residuals `res` at times
+// `tau`. A feedthrough follows each row's pump, so where the pump changes
+// over the rows (a switch-on among them, an amplitude loop moving it) the
+// line is fitted beside a free term g V per pickoff: the step the pump makes
+// there is the feedthrough's, not the force-driven slope's, and taken for
+// the slope it would project the feedthrough out of the jump. Empty when
+// the rows do not determine a slope.
+std::optional<std::array<cplx, 2>> line_slope(const std::vector<double>& tau,
+                                              const std::vector<double>& pump_v,
+                                              const std::vector<std::array<cplx, 2>>& res) {
+  const std::size_t n = tau.size();
+  // The pump's part that a line does not hold; below this share of its mean
+  // it is a constant, which the line's offset already takes.
+  constexpr double kMinPumpChange = 1e-3;
+  Eigen::MatrixXd a(n, 3);
+  double mean_v = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    a(static_cast<Eigen::Index>(j), 0) = 1.0;
+    a(static_cast<Eigen::Index>(j), 1) = tau[j];
+    a(static_cast<Eigen::Index>(j), 2) = pump_v.size() == n ? pump_v[j] : 0.0;
+    mean_v += a(static_cast<Eigen::Index>(j), 2) / static_cast<double>(n);
+  }
+  const Eigen::MatrixXd line = a.leftCols(2);
+  const Eigen::VectorXd v_left =
+      a.col(2) - line * line.colPivHouseholderQr().solve(Eigen::VectorXd(a.col(2)));
+  const bool with_pump =
+      mean_v > 0.0 && v_left.norm() > kMinPumpChange * mean_v * std::sqrt(static_cast<double>(n));
+  const Eigen::MatrixXd m = with_pump ? a : line;
+  const Eigen::MatrixXd mtm = m.transpose() * m;
+  const Eigen::LDLT<Eigen::MatrixXd> f(mtm);
+  if (f.info() != Eigen::Success || !(std::abs(f.vectorD().minCoeff()) > 0.0)) return std::nullopt;
+  std::array<cplx, 2> slope{};
+  for (std::size_t k = 0; k < 2; ++k) {
+    Eigen::VectorXd re(n), im(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      re(static_cast<Eigen::Index>(j)) = res[j][k].real();
+      im(static_cast<Eigen::Index>(j)) = res[j][k].imag();
+    }
+    const Eigen::VectorXd br = f.solve(m.transpose() * re);
+    const Eigen::VectorXd bi = f.solve(m.transpose() * im);
+    slope[k] = cplx(br(1), bi(1));
+  }
+  return slope;
+}
 
 EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   EdgeJump ej;
-  double phase = 0.0;
+  double phase = 0.0, theta = 0.0;
   std::vector<std::size_t> rows = e.forced_rows;
   rows.insert(rows.end(), e.slope_rows.begin(), e.slope_rows.end());
-  const auto pred = predict_rows(d, p, e.free_segment, rows, &phase);
+  const auto pred = predict_rows(d, p, e.free_segment, rows, &phase, &theta);
+  ej.sign_known = kPi / 4.0 - std::abs(theta) >= kBranchMarginRad;
   const std::size_t near = e.forced_rows.front();
   const std::size_t free_row = e.at_start ? near + 1 : near - 1;
   const double t_e = 0.5 * (d.t_s[near] + d.t_s[free_row]);
@@ -91,24 +158,14 @@ EdgeJump edge_jump(const Dataset& d, const Params& p, const Edge& e) {
   // The slope direction from the rows beyond (straight line; independent
   // noise), or from the jump's own rows when the run is too short.
   Vec4 dir = r1;
-  const std::size_t m0 = e.forced_rows.size();
   if (e.slope_rows.size() >= 8) {
-    double st = 0.0, stt = 0.0, n = 0.0;
-    std::array<cplx, 2> sz{}, stz{};
-    for (std::size_t j = m0; j < rows.size(); ++j) {
-      const double tau = (d.t_s[rows[j]] - t_e) / dt;
-      const std::array<cplx, 2> r{d.x[rows[j]] - pred[j][0], d.y[rows[j]] - pred[j][1]};
-      n += 1.0, st += tau, stt += tau * tau;
-      for (std::size_t k = 0; k < 2; ++k)
-        sz[k] += r[k], stz[k] += tau * r[k];
+    std::vector<std::array<cplx, 2>> res;
+    std::vector<double> tau;
+    for (std::size_t j = e.forced_rows.size(); j < rows.size(); ++j) {
+      tau.push_back((d.t_s[rows[j]] - t_e) / dt);
+      res.push_back({d.x[rows[j]] - pred[j][0], d.y[rows[j]] - pred[j][1]});
     }
-    const double den = n * stt - st * st;
-    if (den > 0.0) {
-      std::array<cplx, 2> slope{};
-      for (std::size_t k = 0; k < 2; ++k)
-        slope[k] = (n * stz[k] - st * sz[k]) / den;
-      dir = real4(slope);
-    }
+    if (const auto slope = line_slope(tau, e.slope_pump_v, res)) dir = real4(*slope);
   }
   ej.proj = Eigen::Matrix4d::Identity();
   if (dir.squaredNorm() > 0.0) ej.proj -= dir * dir.transpose() / dir.squaredNorm();
@@ -182,28 +239,37 @@ std::array<cplx, 2> sign_free_detection(const std::vector<EdgeJump>& jumps, doub
   return m;
 }
 
+// Sign of edge `ej`'s feedthrough under c: the convention's where it is
+// known, else the one that fits (none while c is still zero).
+double edge_sign(const EdgeJump& ej, const Vec4& c, bool free_signs) {
+  if (ej.sign_known && !free_signs) return 1.0;
+  const double dot = ej.j.dot(feed_map(ej) * c);
+  return dot < 0.0 ? -1.0 : dot > 0.0 ? 1.0 : 0.0;
+}
+
 // Least-squares feedthrough c (re/im c_x, re/im c_y) over the edges, with the
-// sign the wave phase convention gives or (free_signs) one sign per edge,
+// sign the wave phase convention gives (edges near the branch cut of the
+// pattern angle with the sign that fits) or (free_signs) one sign per edge,
 // iterated from `c`. Its cost and the 1-sigma of the larger |c_k|, scaled by
 // the scatter of the edges about the fit when it exceeds the noise
 // (extrapolation errors the noise alone does not cover).
 Vec4 solve_feedthrough(const std::vector<EdgeJump>& jumps, bool free_signs, Vec4 c, double& cost,
                        double& sigma) {
-  for (int it = 0; it < (free_signs ? 5 : 1); ++it) {
+  for (int it = 0; it < 5; ++it) {
     Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
     Vec4 rhs = Vec4::Zero();
     for (const auto& ej : jumps) {
+      const double sgn = edge_sign(ej, c, free_signs);
+      if (sgn == 0.0) continue;  // an edge of unknown sign before c is known
       const Eigen::Matrix4d f = feed_map(ej);
-      const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
       a += f.transpose() * f / ej.var;
       rhs += sgn * f.transpose() * ej.j / ej.var;
     }
     c = a.ldlt().solve(rhs);
     cost = 0.0;
     for (const auto& ej : jumps) {
-      const Eigen::Matrix4d f = feed_map(ej);
-      const double sgn = free_signs && ej.j.dot(f * c) < 0.0 ? -1.0 : 1.0;
-      cost += (ej.j - sgn * f * c).squaredNorm() / ej.var;
+      const double sgn = edge_sign(ej, c, free_signs);
+      cost += (ej.j - sgn * feed_map(ej) * c).squaredNorm() / ej.var;
     }
     const Eigen::Matrix4d cov = a.inverse();
     const double dof = std::max(1.0, 3.0 * static_cast<double>(jumps.size()) - 4.0);
@@ -213,13 +279,33 @@ Vec4 solve_feedthrough(const std::vector<EdgeJump>& jumps, bool free_signs, Vec4
   return c;
 }
 
+// One sign per edge leaves the overall sign of c open: it is the one the
+// edges clear of the branch cut agree with under the wave phase convention
+// (a producer with another convention then still gets the pump's sign where
+// the two agree most).
+Vec4 orient_to_convention(const std::vector<EdgeJump>& jumps, const Vec4& c) {
+  double agree = 0.0;
+  for (const auto& ej : jumps) {
+    if (ej.sign_known) agree += ej.j.dot(feed_map(ej) * c) / ej.var;
+  }
+  return agree < 0.0 ? Vec4(-c) : c;
+}
+
 void debug_edges(const Dataset& d, const std::vector<EdgeJump>& jumps,
                  const std::vector<const Edge*>& used) {
   for (std::size_t i = 0; i < jumps.size(); ++i) {
-    std::fprintf(stderr, "edge %zu t=%.3f |J|/sd=%.2f V=%.2f J=%s\n", i,
-                 d.t_s[used[i]->forced_rows[0]], jumps[i].j.norm() / std::sqrt(jumps[i].var),
-                 jumps[i].pump_v,
-                 fmt("%.2e %.2e %.2e", jumps[i].j(0), jumps[i].j(1), jumps[i].j(2)).c_str());
+    const auto z = cplx2(jumps[i].j);
+    const cplx u = std::conj(jumps[i].phasor) / jumps[i].pump_v;
+    std::fprintf(
+        stderr, "edge %zu%s t=%.3f |J|/sd=%.2f V=%.2f phi=%.1f wx=%.2e@%.1f wy=%.2e@%.1f\n", i,
+        jumps[i].sign_known ? "" : "?", d.t_s[used[i]->forced_rows[0]],
+        jumps[i].j.norm() / std::sqrt(jumps[i].var), jumps[i].pump_v,
+        std::arg(jumps[i].phasor) * 180 / kPi, std::abs(z[0] * u), std::arg(z[0] * u) * 180 / kPi,
+        std::abs(z[1] * u), std::arg(z[1] * u) * 180 / kPi);
+    std::string pv = fmt(" skip %.0f:", static_cast<double>(used[i]->pump_off_rows));
+    for (double v : used[i]->forced_pump_v)
+      pv += fmt(" %.2f", v);
+    std::fprintf(stderr, "   pump%s\n", pv.c_str());
   }
 }
 
@@ -242,13 +328,20 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
     // small part of the rows' own is not evidence: there is no feedthrough
     // to see, or the pump there is what the fit leaves of a moving one.
     const EdgeJump ej = edge_jump(d, p, *e);
-    if (!(e->pump_v > 0.0) || ej.pump_v < kMinEdgePumpShare * e->pump_v) continue;
+    if (!(e->pump_v > 0.0) || ej.pump_v < kMinEdgePumpShare * e->pump_v ||
+        e->pump_off_rows > kMaxPumpOffRows)
+      continue;
     jumps.push_back(ej);
     kept.push_back(e);
   }
   used.swap(kept);
   fs.dropped = drop_transients(jumps, used);
   if (jumps.size() < 3) return fs;
+  // Every edge near the branch cut: the convention is the only reference.
+  if (std::none_of(jumps.begin(), jumps.end(), [](const EdgeJump& ej) { return ej.sign_known; })) {
+    for (auto& ej : jumps)
+      ej.sign_known = true;
+  }
   const bool debug = std::getenv("HRG_AUDIT_DEBUG") != nullptr;
   if (debug) debug_edges(d, jumps, used);
   const std::array<cplx, 2> m = sign_free_detection(jumps, ln_neff, fs);
@@ -276,7 +369,7 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff) {
         best_cost, std::max(std::hypot(free_c(0), free_c(1)), std::hypot(free_c(2), free_c(3))));
   }
   if (fixed_cost - best_cost > 2.0 * static_cast<double>(jumps.size()) + 25.0) {
-    best_c = free_c;
+    best_c = orient_to_convention(jumps, free_c);
     fs.sigma = best_sigma;
   }
   fs.c_re_im = {best_c(0), best_c(1), best_c(2), best_c(3)};
