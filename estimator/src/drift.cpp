@@ -27,12 +27,32 @@ ParamVector with_damping_scale(const ParamVector& p, double damping_scale) {
   return out;
 }
 
-double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad) {
+double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad,
+                             double growth_per_s, double aB_over_aA, double damping_scale) {
   const double s4 = std::sin(4.0 * theta_A_rad);
   const double c4 = std::cos(4.0 * theta_A_rad);
-  const double kappa =
-      (p(kNu) + p(kDnuC) * c4 + p(kDnuS) * s4) / (1.0 + 0.5 * (eps_p * c4 + eps_q * s4));
+  const double decay = damping_scale * (p(kNu) + p(kDnuC) * c4 + p(kDnuS) * s4) +
+                       (p(kDwC) * s4 - p(kDwS) * c4) * aB_over_aA;
+  const double kappa = (growth_per_s + decay) / (1.0 + 0.5 * (eps_p * c4 + eps_q * s4));
   return kappa * 0.5 * (eps_q * c4 - eps_p * s4);
+}
+
+double KnownGapDrift::step(const ParamVector& p, double eps_p, double eps_q, double t_s,
+                           double theta_A_rad, double a_A_v, double aB_over_aA,
+                           double damping_scale) {
+  if (!std::isfinite(a_A_v) || !(a_A_v > 0.0) || !std::isfinite(t_s)) {
+    started_ = false;
+    growth_per_s_ = 0.0;
+    return 0.0;
+  }
+  const double ln_a = std::log(a_A_v);
+  const double dt = t_s - t_last_s_;
+  growth_per_s_ = started_ && dt > 0.0 && dt <= max_gap_s_ ? (ln_a - ln_a_last_) / dt : 0.0;
+  started_ = true;
+  t_last_s_ = t_s;
+  ln_a_last_ = ln_a;
+  return known_gap_drift_rad_s(p, eps_p, eps_q, theta_A_rad, growth_per_s_, aB_over_aA,
+                               damping_scale);
 }
 
 double DriftCompensator::step(double theta_A_rad, double aB_over_aA, double d_phi_rad_s,

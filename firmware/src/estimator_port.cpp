@@ -151,8 +151,8 @@ void EstimatorPort::add_control_sample(est::Estimator& e, const ChainRecord& s, 
   (void)e.add_control_sample(control_sample(s, scale));
 }
 
-double EstimatorPort::control_drift_rad_s(double theta_a_rad) const {
-  return est_.has_model() ? est_.d_phi_rad_s(theta_a_rad) : 0.0;
+double EstimatorPort::control_drift_rad_s(const ChainRecord& s) {
+  return est_.has_model() ? est_.d_phi_rad_s(control_sample(s, damping_scale(s.wave.E_v2))) : 0.0;
 }
 
 void EstimatorPort::solve() {

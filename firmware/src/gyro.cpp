@@ -233,7 +233,7 @@ void Gyro::task_output(Gyro& g) {
   // The control loops drift the pattern only while they drive it.
   double control = 0.0;
   if (apply && g.cfg_.compensate_control_drift && g.status_.excitation_on) {
-    control = g.identifier_.control_drift_rad_s(o.theta_A_rad);
+    control = g.identifier_.control_drift_rad_s(o);
   }
   drift += control;
   g.status_.control_drift_rad_s = control;

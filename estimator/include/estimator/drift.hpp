@@ -41,14 +41,46 @@ ParamVector with_damping_scale(const ParamVector& p, double damping_scale);
 
 // D_Phi of the ring-electrode pump for a known gap harmonic (eps_p, eps_q),
 // the same physics as PumpDriftEstimator below with the gap given (a
-// calibration) instead of fitted. The AGC holds the amplitude, so the pump's
-// growth rate kappa balances the damping along the wave:
-//   kappa (1 + eps_p/2 cos4th + eps_q/2 sin4th) = nu + dnu_C cos4th + dnu_S sin4th
-// (the slow a_A'/a_A of the loop averages out), and then
+// calibration) instead of fitted. The pump's in-phase growth rate kappa is
+// what eq. 3 leaves on a_A (the left side of eq. 20 over a_A):
+//   kappa (1 + eps_p/2 cos4th + eps_q/2 sin4th)
+//     = a_A'/a_A + k (nu + dnu_C cos4th + dnu_S sin4th) + (dw_C sin4th - dw_S cos4th) a_B/a_A
+// (k the damping scale, WaveSample::damping_scale), and then
 //   D_Phi = kappa (eps_q/2 cos4th - eps_p/2 sin4th).
-// Needs no pump gain and no fit of its own: right from the first model.
-// rad/s in Omega K units. Any context.
-double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad);
+// growth_per_s is a_A'/a_A: 0 where the AGC holds the amplitude, but the
+// pump also makes up what each free-decay window lost (nu T_off, ~12 % of
+// the pump's work with the default windows), so the output path gives the
+// measured one (KnownGapDrift). Needs no pump gain and no fit of its own:
+// right from the first model. rad/s in Omega K units. Any context.
+double known_gap_drift_rad_s(const ParamVector& p, double eps_p, double eps_q, double theta_A_rad,
+                             double growth_per_s = 0.0, double aB_over_aA = 0.0,
+                             double damping_scale = 1.0);
+
+// known_gap_drift_rad_s with the wave's measured growth a_A'/a_A, for the
+// output: one call per output sample while the excitation is on. The growth
+// is the difference of ln a_A from the previous call over the time between,
+// so its integral over an excitation-on stretch is exactly the change of
+// ln a_A there (the amplitude noise does not add up); a gap of more than
+// max_sample_gap_s (a free-decay window: no pump) starts afresh at growth 0.
+// Context: control-rate task; no heap.
+class KnownGapDrift {
+ public:
+  explicit KnownGapDrift(double max_sample_gap_s = 0.0015) : max_gap_s_(max_sample_gap_s) {}
+  // D_Phi (rad/s, Omega K units) at time t_s for the model p and gap
+  // (eps_p, eps_q); a non-finite or non-positive a_A gives 0 and restarts.
+  double step(const ParamVector& p, double eps_p, double eps_q, double t_s, double theta_A_rad,
+              double a_A_v, double aB_over_aA, double damping_scale);
+  void restart() { started_ = false; }
+  // The last growth a_A'/a_A used (1/s).
+  double growth_per_s() const { return growth_per_s_; }
+
+ private:
+  double max_gap_s_;
+  bool started_{false};
+  double t_last_s_{0};
+  double ln_a_last_{0};
+  double growth_per_s_{0};
+};
 
 // Integrates the modelled drift into an angle correction (input-axis radians).
 // Context: control-rate task. No heap.

@@ -133,8 +133,18 @@ class Estimator {
   double d_phi_rad_s(double theta_A_rad) const {
     return control_.used_d_phi_rad_s() + pump_d_phi_rad_s(theta_A_rad);
   }
+  // D_Phi for the output at one sample with the excitation on (one call
+  // per output sample: the known gap's part follows the wave's amplitude
+  // from call to call, KnownGapDrift); otherwise as d_phi_rad_s(theta).
+  double d_phi_rad_s(const ControlDriftEstimator::Sample& s) {
+    if (!config_.gap.known() || gap_refuted_ || !has_model_) return d_phi_rad_s(s.theta_A_rad);
+    const double a = s.a_A_v > 0.0 ? s.a_B_v / s.a_A_v : 0.0;
+    return control_.used_d_phi_rad_s() + known_gap_.step(model_, config_.gap.eps_p,
+                                                         config_.gap.eps_q, s.t_s, s.theta_A_rad,
+                                                         s.a_A_v, a, s.damping_scale);
+  }
   // The ring pump's part of D_Phi: from the known gap (Config::gap) with the
-  // accepted model, else from the online fit once it is usable.
+  // accepted model at the AGC's balance, else from the online fit once it is usable.
   double pump_d_phi_rad_s(double theta_A_rad) const {
     if (config_.gap.known() && !gap_refuted_) {
       return has_model_
@@ -174,6 +184,7 @@ class Estimator {
   bool has_model_ = false;
   ControlDriftEstimator control_;
   PumpDriftEstimator pump_;
+  KnownGapDrift known_gap_;
   void check_window(const WindowContribution& w);
   // The known gap against the online fit, once per folded segment: refuted
   // when the fit stands PumpDriftEstimator::Config::min_gap_sigmas of its own

@@ -81,8 +81,11 @@ class ResonatorIdentifier {
   // Control-loop drift D_Phi (seed sections 6-7, eq. 23): fed with the
   // excitation on, added to the output only with the excitation on.
   virtual void add_control_sample(const ChainRecord& s) { (void)s; }
-  virtual double control_drift_rad_s(double theta_a_rad) const {
-    (void)theta_a_rad;
+  // D_Phi at the record's pattern angle; called once per output frame with
+  // the excitation on (a known gap's part follows the wave's amplitude from
+  // one call to the next).
+  virtual double control_drift_rad_s(const ChainRecord& s) {
+    (void)s;
     return 0.0;
   }
 };

@@ -45,7 +45,7 @@ class EstimatorPort final : public ResonatorIdentifier {
     return fw::damping_scale(model_, temp_valid_ ? temp_c_ : model_.temperature_ref_c, e_v2);
   }
   void add_control_sample(const ChainRecord& s) override;
-  double control_drift_rad_s(double theta_a_rad) const override;
+  double control_drift_rad_s(const ChainRecord& s) override;
 
   const est::Estimator& estimator() const { return est_; }
   // The pickoff self-calibration over the same windows (campaign and check
