@@ -275,3 +275,39 @@ TEST(ControlDrift, AKnownGapGivesThePumpsDriftAtTheAgcBalance) {
   e.set_known_gap({0.0, 0.0});
   CHECK_FALSE(e.known_gap().known());
 }
+
+TEST(ControlDrift, AKnownGapTakesThePumpsGrowthFromTheWavesAmplitude) {
+  // GIVEN the resonator identified, a known gap harmonic and the wave growing
+  // at g = 0.02 1/s with the excitation on (the AGC making up what a
+  // free-decay window lost), sampled at 1 kHz, with a quadrature ratio q
+  const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  const double eps_p = 0.02, eps_q = 0.01, th = 0.3, q = 0.01, k = 1.1, g = 0.02;
+  KnownGapDrift gap;
+  const double a0 = 1.0;
+  double integral = 0.0;
+  double d_first = 0.0;
+  for (int i = 0; i <= 1000; ++i) {
+    const double t = 10.0 + 1e-3 * i;
+    const double d = gap.step(p, eps_p, eps_q, t, th, a0 * std::exp(g * (t - 10.0)), q, k);
+    if (i == 0) d_first = d;
+    if (i > 0) integral += d * 1e-3;
+  }
+  // THEN the first sample after a start has no growth: the balance of eq. 20
+  // with the damping scale and the split term, kappa (1 + eps_p/2 c4 +
+  // eps_q/2 s4) = k (nu + dnu(th)) + (dw_C s4 - dw_S c4) q
+  const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
+  const double f = 0.5 * (eps_q * c4 - eps_p * s4) / (1.0 + 0.5 * (eps_p * c4 + eps_q * s4));
+  const double decay =
+      k * (p(kNu) + p(kDnuC) * c4 + p(kDnuS) * s4) + (p(kDwC) * s4 - p(kDwS) * c4) * q;
+  DOUBLES_EQUAL(decay * f, d_first, 1e-15);
+  DOUBLES_EQUAL(known_gap_drift_rad_s(p, eps_p, eps_q, th, 0.0, q, k), d_first, 0.0);
+  // AND over the second it adds the pump's extra work: (decay + g) f per
+  // second, the growth exact as the change of ln a_A
+  DOUBLES_EQUAL((decay + g) * f, integral, 1e-12);
+  DOUBLES_EQUAL(g, gap.growth_per_s(), 1e-9);
+  // AND a gap in the samples (a free-decay window: the amplitude fell with
+  // no pump) starts afresh at growth 0, as does a bad amplitude
+  const double after = gap.step(p, eps_p, eps_q, 12.0, th, 0.5, q, k);
+  DOUBLES_EQUAL(decay * f, after, 1e-15);
+  DOUBLES_EQUAL(0.0, gap.step(p, eps_p, eps_q, 12.001, th, 0.0, q, k), 0.0);
+}
