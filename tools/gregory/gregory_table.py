@@ -127,6 +127,9 @@ SETS = {"default": ROWS, "variants": VARIANTS}
 # moves ~0.25 deg/h per 1e-5 and needs ~1e-5; from 1800 s the windows are 5 s
 # long and the audit's sigma ~1.3e-6 (tools/gregory/README.md).
 GAIN_RUN_S = 1800.0
+# The gap rows stay at the scenario's length: the audit's gap harmonic does
+# not sharpen with the run (sigma ~1.3e-3 at 365 s, 1.7e-3 to 2.7e-3 and
+# biased at 1800 s; tools/gregory/README.md, "The gap rows' length").
 
 
 def row_run_s(rows, name, duration):
