@@ -210,13 +210,14 @@ bool PumpDriftEstimator::add_sample(const Sample& s) {
   }
   const int lag = std::clamp(config_.pump_lag_samples, 0, kMaxPumpLag);
   const std::size_t n_ring = w_ring_.size();
-  w_ring_[static_cast<std::size_t>(w_count_) % n_ring] =
-      s.pump_v * s.pump_v * std::cos(s.pump_phase_error_rad);
-  if (++w_count_ <= lag) {
+  w_pos_ = (w_pos_ + 1) % n_ring;
+  w_ring_[w_pos_] = s.pump_v * s.pump_v * std::cos(s.pump_phase_error_rad);
+  if (w_count_ < lag + 1) ++w_count_;
+  if (w_count_ <= lag) {
     t_last_s_ = s.t_s;  // history only: the rows before it saw an unknown pump
     return true;
   }
-  const double w = w_ring_[static_cast<std::size_t>(w_count_ - 1 - lag) % n_ring];
+  const double w = w_ring_[(w_pos_ + n_ring - static_cast<std::size_t>(lag)) % n_ring];
   w_last_ = w;
   const double c4 = std::cos(4.0 * s.theta_A_rad);
   const double s4 = std::sin(4.0 * s.theta_A_rad);

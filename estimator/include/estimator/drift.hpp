@@ -318,9 +318,11 @@ class PumpDriftEstimator {
   VecR seg_sum_{VecR::Zero()};
   int seg_blocks_{0};
   double w_last_{0};
-  // The last pump_lag_samples + 1 pumps w (ring), and how many since the
-  // segment started: a segment's first row waits for its pump.
+  // The last pump_lag_samples + 1 pumps w (ring, the newest at w_pos_), and
+  // how many since the last restart (up to pump_lag_samples + 1): the first
+  // row after a restart waits for its pump.
   std::array<double, kMaxPumpLag + 1> w_ring_{};
+  std::size_t w_pos_{0};
   int w_count_{0};
   // refresh_fit(): kappa_2 of m_'s 3x3, the coefficients and gap_sigmas()
   // (zero until valid).
