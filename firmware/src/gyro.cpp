@@ -269,8 +269,11 @@ void Gyro::check_model() {
   // a fit made while turning is most likely wrong) agreed with it.
   status_.compensation_applied = status_.model_checks_failed == failed_before_restart_;
   const bool checked = cfg_.identify && cfg_.windows.check_period_frames != 0;
+  // A control-loop drift once measured and added, no longer added, leaves
+  // the output short of it: not one the firmware stands behind while so.
+  const bool control_lost = cfg_.compensate_control_drift && h.control_drift_lost;
   status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0) &&
-                               status_.pump_edge.verdict != PumpEdgeVerdict::step;
+                               status_.pump_edge.verdict != PumpEdgeVerdict::step && !control_lost;
 }
 
 void Gyro::restart_identification() {

@@ -35,8 +35,8 @@ struct Resonator {
 
 // The main job's schedule with the resonator of a chart point (as `hrg study
 // tolerance` runs it: dmu = dQ/Q / 2, the firmware configured for it).
-RunConfig chart_job(const Resonator& res) {
-  RunConfig j = hrg::sim_run::default_run(kRunS, 16);
+RunConfig chart_job(const Resonator& res, double run_s = kRunS) {
+  RunConfig j = hrg::sim_run::default_run(run_s, 16);
   j.sim.resonator.q = res.q;
   j.sim.resonator.dmu = 0.5 * res.dq_over_q;
   j.sim.resonator.split_hz = res.split_hz;
@@ -61,12 +61,13 @@ struct Run {
   double model_sigma_dph = 0.0;
 };
 
-Run run_chart(const Resonator& res) {
+Run run_chart(const Resonator& res, double run_s = kRunS, double pump_forgetting_s = 0.0) {
   Run out;
-  out.j = chart_job(res);
+  out.j = chart_job(res, run_s);
+  out.j.firmware.estimator.pump.forgetting_time_s = pump_forgetting_s;
   const RunConfig& j = out.j;
   hrg::sim_run::RunOptions opt;
-  opt.observe_every_s = kRunS;  // once, at the end
+  opt.observe_every_s = run_s;  // once, at the end
   opt.observer = [&out, &res](const hrg::fw::app::Firmware& fw, const hrg::sim::SimTarget&) {
     const hrg::est::PumpDriftEstimator& p = fw.estimator().estimator().pump_drift();
     const Eigen::Vector3d b = p.coefficients();
@@ -149,4 +150,71 @@ TEST(ChartDPhi, AGapHarmonicIsStillFoundAndAppliedWithinItsUncertainty) {
                          run.j.firmware.gyro.angular_gain * kRadSToDph;
   CHECK(run.r.fit_comp.ok);
   CHECK(run.r.fit_comp.amplitude() < 0.1 * gap_dph);
+}
+
+namespace {
+// The chart's gap harmonic 0.03 along 10 deg (`hrg study tolerance`'s
+// gap_axis_deg) on its most relaxed resonator: the raw drift (~800 deg/h)
+// takes the pattern to its equilibrium angle during the parks, where the
+// pump fit's rows pile up at one angle.
+Resonator relaxed_with_gap() {
+  const double axis = 4.0 * 10.0 * kPi / 180.0;
+  return {1.0e6, 0.3, 1.0e-4, 0.03 * std::cos(axis), 0.03 * std::sin(axis)};
+}
+// The pump's drift through the gap, nu |eps| / 2 / K, deg/h (eqs. 25-27).
+double gap_drift_dph(const Run& run, const Resonator& res) {
+  return run.j.sim.resonator.nu_per_s() * std::hypot(res.eps_p, res.eps_q) / 2.0 /
+         run.j.firmware.gyro.angular_gain * kRadSToDph;
+}
+void print_parks(const RunResult& r) {
+  for (const hrg::sim_run::ParkResult& p : r.parks)
+    std::printf("\n    park %7.2f deg: raw %+9.3f comp %+9.3f deg/h, valid %d",
+                p.theta_rad * 180.0 / kPi, p.bias_raw_dph, p.bias_comp_dph, p.model_valid ? 1 : 0);
+}
+}  // namespace
+
+TEST(ChartDPhi, AGapHarmonicStaysCompensatedWhileTheParksSitAtOneAngle) {
+  // GIVEN Q 1e6, dQ/Q 0.3 and the chart's gap harmonic, an hour's run
+  const Resonator res = relaxed_with_gap();
+  const Run run = run_chart(res, 3600.0);
+  print_parks(run.r);
+  // THEN the pump fit is in force at the end, its gap the true one within
+  // its uncertainty (Hotelling's T of the batches at 1 %, as above: 5.05)
+  CHECK(run.pump.usable);
+  CHECK(run.pump.sigmas_from_truth >= 0.0);
+  CHECK(run.pump.sigmas_from_truth < 5.05);
+  // AND every park the firmware calls valid is compensated to within 2 % of
+  // the gap's drift (~88 deg/h here; the pump fit withdrawn, as it was when
+  // its 3x3 grew ill-conditioned at the equilibrium angle, left -63 deg/h)
+  // and never worse than raw
+  const double tol_dph = 0.02 * gap_drift_dph(run, res);
+  std::size_t valid = 0;
+  for (const hrg::sim_run::ParkResult& p : run.r.parks) {
+    if (!p.model_valid) continue;
+    ++valid;
+    CHECK(std::fabs(p.bias_comp_dph) < tol_dph);
+    CHECK(std::fabs(p.bias_comp_dph) <= std::fabs(p.bias_raw_dph));
+  }
+  CHECK(valid >= 8);
+}
+
+TEST(ChartDPhi, APumpDriftThatIsWithdrawnMakesTheCompensationNotValid) {
+  // GIVEN the same gyro with a pump fit that forgets in 300 s: parked at its
+  // equilibrium angle, its 3x3 loses the other angles and the fit is withdrawn
+  const Resonator res = relaxed_with_gap();
+  const Run run = run_chart(res, 3600.0, 300.0);
+  print_parks(run.r);
+  CHECK_FALSE(run.pump.usable);
+  // THEN the parks whose output lacks the pump's drift are not called valid:
+  // every valid park is compensated to within 2 % of the gap's drift
+  const double tol_dph = 0.02 * gap_drift_dph(run, res);
+  std::size_t valid = 0;
+  for (const hrg::sim_run::ParkResult& p : run.r.parks) {
+    if (!p.model_valid) continue;
+    ++valid;
+    CHECK(std::fabs(p.bias_comp_dph) < tol_dph);
+  }
+  // AND the firmware does not stand behind the output at the end
+  CHECK(valid < run.r.parks.size());
+  CHECK_FALSE(run.r.compensation_valid);
 }

@@ -231,8 +231,10 @@ class PumpDriftEstimator {
     int block_samples = 10;
     double segment_s = 10.0;         // a segment is folded into the fit at this length
     double forgetting_time_s = 0.0;  // 0: keep everything
-    double max_kappa_2 = 1.0e3;      // conditioning of the 3x3 before the gap terms are used
-    double min_fit_s = 20.0;         // folded excitation-on time before the fit is used
+    // Conditioning of the 3x3 before the gap terms are used. Without
+    // forgetting, once reached the fit stays valid (valid()).
+    double max_kappa_2 = 1.0e3;
+    double min_fit_s = 20.0;  // folded excitation-on time before the fit is used
     double max_sample_gap_s = 0.005;
     // The pump's part of D_Phi is used (Estimator::d_phi_rad_s) only when
     // the fitted gap harmonic gap() is at least this. On an ideal electrode
@@ -247,7 +249,18 @@ class PumpDriftEstimator {
     // ideal electrode (1800 s runs, Q 1e6 ... 2e7, dQ/Q 0.01 ... 0.3): at
     // most 3.4 at the end. 0: not checked.
     double min_gap_sigmas = 6.5;
+    // Samples between the pump a sample carries (Sample::pump_v, written for
+    // the next block) and the rows whose amplitude it moves: the DAC's lead
+    // and the demodulator's centre (fw::app::pump_lag_samples, 3 on the
+    // default chain). The fit integrates the pump of lag samples before,
+    // the pump that acted when the row's amplitude was measured. Misaligned
+    // by 3 ms, the fit read the AGC's recovery after each window (the pump
+    // high while the amplitude catches up) as 0.2 % more pump gain than the
+    // steady parks: the gap harmonic then moved by ~8 % as the parks added
+    // one angle at a time. 0 ... kMaxPumpLag.
+    int pump_lag_samples = 0;
   };
+  static constexpr int kMaxPumpLag = 7;
   using Sample = ControlDriftEstimator::Sample;
 
   PumpDriftEstimator() { batch_.fill(MatR::Zero()); }
@@ -260,16 +273,20 @@ class PumpDriftEstimator {
   void set_model(const ParamVector& p, const ParamMatrix& covariance = ParamMatrix::Zero());
   // One control-rate sample with the excitation on (pump_v >= 0; 0 when the
   // AGC is at its lower limit). Bad input ends the segment (folding what it
-  // holds) and returns false.
+  // holds, as restart()) and returns false.
   bool add_sample(const Sample& s);
-  // Ends the present segment (call when a free-decay window starts).
+  // Ends the present segment (call when a free-decay window starts); the next
+  // segment's first row waits for Config::pump_lag_samples pumps.
   void restart();
+  // The fit is used: min_fit_s folded and kappa_2() within max_kappa_2, or
+  // (without forgetting) it was once.
   bool valid() const;
   // Excitation-on time folded into the fit (s) and the 2-norm condition
   // number of its 3x3 normal matrix (what valid() compares).
   double fit_s() const { return fit_s_; }
   double kappa_2() const;
-  // D_Phi of the pump at pattern angle theta for the last pump drive, rad/s.
+  // D_Phi of the pump at pattern angle theta for the pump acting at the last
+  // sample's row (Config::pump_lag_samples back), rad/s.
   double d_phi_rad_s(double theta_A_rad) const;
   // (b0, b1, b2) = c (1, eps_p/2, eps_q/2); zero before valid().
   Eigen::Vector3d coefficients() const;
@@ -333,9 +350,16 @@ class PumpDriftEstimator {
   VecR seg_sum_{VecR::Zero()};
   int seg_blocks_{0};
   double w_last_{0};
+  // The last pump_lag_samples + 1 pumps w (ring, the newest at w_pos_), and
+  // how many since the last restart (up to pump_lag_samples + 1): the first
+  // row after a restart waits for its pump.
+  std::array<double, kMaxPumpLag + 1> w_ring_{};
+  std::size_t w_pos_{0};
+  int w_count_{0};
   // refresh_fit(): kappa_2 of m_'s 3x3, the coefficients and gap_sigmas()
   // (zero until valid).
   double kappa_2_{std::numeric_limits<double>::infinity()};
+  bool conditioned_{false};  // kappa_2_ has been within Config::max_kappa_2 (valid())
   Eigen::Vector3d coefficients_{Eigen::Vector3d::Zero()};
   double gap_sigmas_{0};
 };

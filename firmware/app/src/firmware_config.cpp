@@ -89,6 +89,7 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
   cfg.gyro.envelope = envelope_reference_config(cfg.chain, conv);
   cfg.gyro.pump_edge.drive_free_rows = drive_free_blocks(cfg.chain, conv.dac_latency_samples);
   cfg.gyro.pump_edge.edge_offset_rows = pump_edge_offset_rows(cfg.chain);
+  cfg.estimator.pump.pump_lag_samples = pump_lag_samples(cfg.chain);
   const double l = static_cast<double>(cfg.chain.block_frames);
   cfg.gyro.pump_edge.row_centre_blocks = (1.0 + 0.5 * dsp::kDecimatorOrder * (l - 1.0)) / l;
 }
@@ -117,6 +118,13 @@ uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_sam
 double pump_edge_offset_rows(const dsp::ChainConfig& chain) {
   const double l = static_cast<double>(chain.block_frames);
   return (chain.dac_lead_frames + 0.5 + 0.5 * dsp::kDecimatorOrder * (l - 1.0)) / l;
+}
+
+int pump_lag_samples(const dsp::ChainConfig& chain) {
+  // The estimator holds kMaxPumpLag pumps (7 blocks of DAC lead and demodulator
+  // delay); a chain slower than that is fitted at that lag.
+  const long lag = std::lround(pump_edge_offset_rows(chain) - 0.5);
+  return static_cast<int>(std::clamp<long>(lag, 0, est::PumpDriftEstimator::kMaxPumpLag));
 }
 
 }  // namespace hrg::fw::app

@@ -16,6 +16,9 @@ struct EstimatorHealth {
   // were checked so far.
   double window_misfit = 0.0;
   uint32_t windows_checked = 0;
+  // A control-loop drift the estimator measured and added is no longer
+  // added (est::Estimator::pump_drift_lost): the compensated output misses it.
+  bool control_drift_lost = false;
 };
 
 }  // namespace hrg::fw

@@ -23,7 +23,11 @@ class EstimatorPort final : public ResonatorIdentifier {
   void end_check_window() override;
   void abort_window() override;
   void solve() override;
-  EstimatorHealth health() const override { return health_; }
+  EstimatorHealth health() const override {
+    EstimatorHealth h = health_;
+    h.control_drift_lost = est_.pump_drift_lost();
+    return h;
+  }
   Identification identification() const override;
   double drift_rad_s(double theta_a_rad, double ab_over_aa, double e_v2) const override {
     return est_.drift_rate_rad_s(theta_a_rad, ab_over_aa, damping_scale(e_v2));

@@ -80,5 +80,12 @@ uint32_t drive_free_blocks(const dsp::ChainConfig& chain, double dac_latency_sam
 // start; a row is centred N (L - 1)/2 frames before its last sample. 3.505 at
 // the default 100-frame blocks (PumpEdgeCheckConfig::edge_offset_rows).
 double pump_edge_offset_rows(const dsp::ChainConfig& chain);
+// Rows between the record that writes a pump (ChainOutputs::pump_v, for the
+// next block) and the row whose centre it acts at: the pump written at row n
+// acts from row n + pump_edge_offset_rows - 1 to n + pump_edge_offset_rows,
+// so at the centre of that interval rounded to a row (3 at the default
+// chain). The pump's gap fit integrates the pump that lag back
+// (est::PumpDriftEstimator::Config::pump_lag_samples).
+int pump_lag_samples(const dsp::ChainConfig& chain);
 
 }  // namespace hrg::fw::app
