@@ -6,7 +6,7 @@
 // audit's excitation rows carry the pull's shape; checked here against the
 // simulator's own feedthrough, then on the benchmark's pair of an
 // electrostatic spring beside a feedthrough (averaged model's telemetry),
-// where the pull hid the spring (slow: three 360 s simulations and two audits).
+// where the pull hid the spring (slow: three 360 s simulations and an audit).
 #include <cmath>
 #include <complex>
 #include <numbers>
