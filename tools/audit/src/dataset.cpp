@@ -228,6 +228,16 @@ std::pair<std::size_t, std::size_t> quiet_stretch(const Rows& r, const Run& run,
   return {best_first, best_len};
 }
 
+// (pump_v / a_A) e^{2 i theta} of row i, theta wrapped to (-pi/4, pi/4]: the
+// branch the wave phase, and a pump that follows it, take. A feedthrough
+// V e^{i phi} c adds V (c_x cos 2 theta + c_y sin 2 theta) / a_A to the
+// measured wave along its own phase (0 without a pump column).
+cplx pump_per_amplitude(const Rows& r, std::size_t i) {
+  if (!r.pump) return 0.0;
+  const double th = std::remainder(r.theta[i], kPi / 2.0);
+  return std::polar(std::abs((*r.pump)[i]) / std::sqrt(std::max(r.a2[i], 1e-30)), 2.0 * th);
+}
+
 // Mean wave frequency and mean inputs over the quiet part of an excitation run.
 void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d) {
   const auto [q0, best_len] = quiet_stretch(r, run, d);
@@ -238,15 +248,20 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.last_row = q1;
   const std::size_t k = 3;
   double ts = 0, te = 0, ps = 0, pe = 0, ls = 0, le = 0;
+  cplx gs, ge;  // mean (pump_v / a_A) e^{2 i theta} at the start and the end
   for (std::size_t j = 0; j < k; ++j) {
     ts += r.t[q0 + j] / k, ps += r.phase[q0 + j] / k;
     te += r.t[q1 - j] / k, pe += r.phase[q1 - j] / k;
     ls += 0.5 * std::log(std::max(r.a2[q0 + j], 1e-30)) / k;
     le += 0.5 * std::log(std::max(r.a2[q1 - j], 1e-30)) / k;
+    gs += pump_per_amplitude(r, q0 + j) / static_cast<double>(k);
+    ge += pump_per_amplitude(r, q1 - j) / static_cast<double>(k);
   }
   f.t0_s = ts;
   f.t1_s = te;
   f.freq_rad_s = (pe - ps) / (te - ts);
+  f.ft_gx_per_s = (ge - gs).real() / (te - ts);
+  f.ft_gy_per_s = (ge - gs).imag() / (te - ts);
   double c4 = 0, s4 = 0, v2 = 0, v2c4 = 0, v2s4 = 0, aa = 0, tc = 0, rr = 0;
   for (std::size_t i = q0; i <= q1; ++i) {
     const double ci = std::cos(4.0 * r.theta[i]), si = std::sin(4.0 * r.theta[i]);

@@ -54,6 +54,12 @@ struct ForcedSegment {
   double mean_a2 = 0.0;              // mean a_A^2
   double mean_temp_c = 0.0;
   double mean_rate_rad_s = 0.0;
+  // Change over the segment, per second and with the ends as for the phase,
+  // of (pump_v / a_A) (cos 2 theta, sin 2 theta), theta in (-pi/4, pi/4] as
+  // the pump's phase follows the wave: a drive feedthrough c (per pickoff, in
+  // the frame of the wave phase) moves the measured phase by
+  // Im(c_x) ft_gx + Im(c_y) ft_gy (Auditor::remove_feedthrough_pull).
+  double ft_gx_per_s = 0.0, ft_gy_per_s = 0.0;
 };
 
 // A switching of exc between a free-decay segment and an excitation segment.
