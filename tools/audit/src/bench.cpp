@@ -9,6 +9,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "batch/batch.hpp"
@@ -421,10 +422,18 @@ void add_counts(BenchResult& res, const BenchResult& r) {
 
 // Designs run in parallel (o.jobs threads) and are added up in design order:
 // the same result and output for any thread count.
+// With o.only_design set, that design alone (what it gives in the full run).
 BenchResult run_benchmark(const BenchOptions& o) {
-  const auto parts =
-      batch::run_indexed(static_cast<std::size_t>(std::max(o.designs, 0)), o.jobs,
-                         [&o](std::size_t d) { return run_design(o, static_cast<int>(d)); });
+  if (o.only_design >= o.designs) {
+    throw std::invalid_argument("audit-bench: design " + std::to_string(o.only_design) +
+                                " is not among the " + std::to_string(o.designs) +
+                                " designs (--n must be above --design)");
+  }
+  const bool one = o.only_design >= 0;
+  const auto parts = batch::run_indexed(
+      one ? 1 : static_cast<std::size_t>(std::max(o.designs, 0)), o.jobs, [&o, one](std::size_t d) {
+        return run_design(o, one ? o.only_design : static_cast<int>(d));
+      });
   BenchResult res;
   double audit_s = 0.0;
   int audits = 0;

@@ -22,8 +22,8 @@ namespace {
 
 void bench_usage(std::FILE* f) {
   std::fprintf(f,
-               "usage: hrg audit-bench [--n DESIGNS] [--seed S] [--jobs N] [--speed-hours H]\n"
-               "                       [--verbose]\n\n"
+               "usage: hrg audit-bench [--n DESIGNS] [--design K] [--seed S] [--jobs N]\n"
+               "                       [--speed-hours H] [--verbose]\n\n"
                "Simulates DESIGNS random resonators and campaigns in turn: a ring-down campaign\n"
                "and envelope-controlled telemetry (sim_target's averaged model), and the\n"
                "firmware's own telemetry (firmware + full-rate sim_target, as hrg sim runs it).\n"
@@ -31,7 +31,9 @@ void bench_usage(std::FILE* f) {
                "at 0.3x-3x its detection threshold. Prints the confusion matrix, the hit rate\n"
                "above 2x, the false-finding rate on nulls and the confusable pairs, then times\n"
                "the audit of an H-hour 200 Hz recording (0: skip). --jobs N runs N designs at a\n"
-               "time (default 0: all cores); the results and the output do not depend on N.\n\n"
+               "time (default 0: all cores); the results and the output do not depend on N.\n"
+               "--design K runs design K of the seed's sequence alone (0-based; --n, when given,\n"
+               "must be above K), with the recordings, lines and counts it has in the full run.\n\n"
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
@@ -81,6 +83,8 @@ double speed_run(double hours, uint64_t seed) {
 struct BenchArgs {
   BenchOptions o;
   double hours = 1.0;
+  bool designs_given = false;  // --n on the command line
+  std::string design_given;    // --design as written (a name with --emit, else a number)
   std::string emit, design = "ringdown", outside;
   std::vector<std::pair<std::string, double>> effects;  // --effect ID VALUE, repeatable
   double duration_s = 480.0, noise_v = -1.0, flicker_hz = 0.0, outside_value = 0.0;
@@ -95,6 +99,7 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
   const bool has_value = i + 1 < args.size();
   if (a == "--n" && has_value) {
     b.o.designs = std::atoi(args[++i]);
+    b.designs_given = true;
   } else if (a == "--jobs" && has_value) {
     if (!batch::parse_jobs(args[++i], b.o.jobs)) {
       std::fprintf(stderr, "hrg audit-bench: --jobs '%s' is not a count (0: all cores)\n", args[i]);
@@ -107,7 +112,7 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
   } else if (a == "--emit" && has_value) {
     b.emit = args[++i];
   } else if (a == "--design" && has_value) {
-    b.design = args[++i];
+    b.design = b.design_given = args[++i];
   } else if (a == "--noise" && has_value) {
     b.noise_v = std::atof(args[++i]);
   } else if (a == "--duration" && has_value) {
@@ -129,6 +134,29 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
   } else {
     std::fprintf(stderr, "hrg audit-bench: unexpected argument '%s'\n", args[i]);
     bench_usage(stderr);
+    return false;
+  }
+  return true;
+}
+
+// Without --emit, --design names one design of the benchmark by its number:
+// it runs alone, and --n (implied as K + 1 when not given) must be above it.
+bool select_design(BenchArgs& b) {
+  if (b.design_given.empty()) return true;
+  char* end = nullptr;
+  const long k = std::strtol(b.design_given.c_str(), &end, 10);
+  if (end == b.design_given.c_str() || *end != '\0' || k < 0 || k > 1000000) {
+    std::fprintf(stderr,
+                 "hrg audit-bench: --design '%s' is not a design number (0, 1, ...); names "
+                 "(ringdown, telemetry, firmware) go with --emit\n",
+                 b.design_given.c_str());
+    return false;
+  }
+  b.o.only_design = static_cast<int>(k);
+  if (!b.designs_given) b.o.designs = b.o.only_design + 1;
+  if (b.o.designs <= b.o.only_design) {
+    std::fprintf(stderr, "hrg audit-bench: --design %d needs --n above it (got --n %d)\n",
+                 b.o.only_design, b.o.designs);
     return false;
   }
   return true;
@@ -180,14 +208,21 @@ int audit_bench_main(std::span<char* const> args) {
     if (!parse_option(args, i, b)) return 2;
   }
   if (!b.emit.empty()) return emit_recording(b);
+  if (!select_design(b)) return 2;
   if (b.o.designs < 0) {
     std::fprintf(stderr, "hrg audit-bench: --n must not be negative\n");
     return 2;
   }
   if (b.o.designs > 0) {
     const BenchResult r = run_benchmark(b.o);
-    std::printf("hrg audit benchmark: %d designs, seed %llu, %zu recordings\n\n", b.o.designs,
-                static_cast<unsigned long long>(b.o.seed), r.cases.size());
+    if (b.o.only_design >= 0) {
+      std::printf("hrg audit benchmark: design %d of %d, seed %llu, %zu recordings\n\n",
+                  b.o.only_design, b.o.designs, static_cast<unsigned long long>(b.o.seed),
+                  r.cases.size());
+    } else {
+      std::printf("hrg audit benchmark: %d designs, seed %llu, %zu recordings\n\n", b.o.designs,
+                  static_cast<unsigned long long>(b.o.seed), r.cases.size());
+    }
     std::fputs(format_benchmark(r).c_str(), stdout);
   }
   if (b.hours > 0.0) speed_run(b.hours, b.o.seed);

@@ -53,7 +53,9 @@ struct AuditOptions {
   // A catalogue finding must stand this many of its standard deviations away
   // from zero and, with structure left (the excitation segments' included)
   // and always for an effect seen only on the excitation segments, remove at
-  // least this share of the baseline's misfit.
+  // least this share of the baseline's misfit beyond the noise (with
+  // structure left on the excitation segments alone, an effect with most of
+  // its evidence on the free decays: of theirs).
   double min_significance = 5.0;
   double min_explains_fraction = 0.2;
   // Evidence for a generic description term (delta BIC): a search over many
@@ -88,8 +90,10 @@ struct Finding {
   double delta_bic = 0.0;
   double heldout_rms_before_v = 0.0;
   double heldout_rms_after_v = 0.0;
-  // Share of the baseline's misfit beyond the noise (chi^2 - n) that this
-  // effect alone removes given everything else accepted (drop-one refit).
+  // Share of the baseline's misfit beyond the noise that this effect alone
+  // removes given everything else accepted (drop-one refit); the free
+  // decays' noise is chi^2 = n, or what the final model leaves there when it
+  // leaves no structure on them (README step 7).
   double explains_fraction = 0.0;
   double significance = 0.0;  // |value| / sigma
   std::string impact;         // in gyro units

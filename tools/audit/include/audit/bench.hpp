@@ -24,6 +24,9 @@ const char* design_name(Design d);
 
 struct BenchOptions {
   int designs = 10;  // random resonators/campaigns; each gives 1 null + 1 per effect
+  // Run only this design of the seed's sequence (0 <= only_design < designs;
+  // -1: all): the same recordings, verbose lines and counts as in the full run.
+  int only_design = -1;
   uint64_t seed = 1;
   double ringdown_s = 480.0;
   double telemetry_s = 360.0;
