@@ -107,12 +107,14 @@ void explain_miss(const Grid& grid, PointResult& p) {
       p.reasons.push_back("does not lock: never reached operate" + seed);
     } else if (s.comp_parks_degenerate) {
       p.reasons.push_back("no ADB from the bias test: " + s.comp_parks_note + seed);
-    } else if (!s.bias_fit) {
-      p.reasons.push_back(fmt("no bias test fits in the run length %.0f s", grid.duration_s) +
-                          seed);
     } else if (s.t_converged_s < 0.0) {
+      // Checked before the bias test: without a model there is nothing to
+      // test, and the run needs to be longer for the identification itself.
       p.reasons.push_back(fmt("not converged in run length: identification still running at %.0f s",
                               grid.duration_s) +
+                          seed);
+    } else if (!s.bias_fit) {
+      p.reasons.push_back(fmt("no bias test fits in the run length %.0f s", grid.duration_s) +
                           seed);
     } else if (s.t_converged_s > s.t_bias_start_s) {
       p.reasons.push_back(fmt("bias test started at %.0f s, before the model converged at %.0f s",
