@@ -61,8 +61,9 @@ class Estimator {
     // The ring electrode's gap harmonic when a calibration gives it
     // (eps_p, eps_q of docs/effects-catalog.md): the pump's part of D_Phi is
     // then known_gap_drift_rad_s with the accepted model, from the first
-    // model on, instead of the online fit (which needs its own significance,
-    // minutes of excitation). Both zero: not known, the online fit is used.
+    // model on, until the online fit is usable (it needs its own
+    // significance, minutes of excitation). Both zero: not known, the online
+    // fit alone.
     struct KnownGap {
       double eps_p = 0.0;
       double eps_q = 0.0;
@@ -138,21 +139,27 @@ class Estimator {
   // per output sample: the known gap's part follows the wave's amplitude
   // from call to call, KnownGapDrift); otherwise as d_phi_rad_s(theta).
   double d_phi_rad_s(const ControlDriftEstimator::Sample& s) {
-    if (!config_.gap.known() || gap_refuted_ || !has_model_) return d_phi_rad_s(s.theta_A_rad);
+    if (!known_gap_in_use()) return d_phi_rad_s(s.theta_A_rad);
     const double a = s.a_A_v > 0.0 ? s.a_B_v / s.a_A_v : 0.0;
     return control_.used_d_phi_rad_s() + known_gap_.step(model_, config_.gap.eps_p,
                                                          config_.gap.eps_q, s.t_s, s.theta_A_rad,
                                                          s.a_A_v, a, s.damping_scale);
   }
-  // The ring pump's part of D_Phi: from the known gap (Config::gap) with the
-  // accepted model at the AGC's balance, else from the online fit once it is usable.
+  // The ring pump's part of D_Phi: from the online fit once it is usable
+  // (it measures this gyro now, over every excitation-on row; a calibration's
+  // gap was measured once, by a fit of a few minutes, and is its prior until
+  // then); before that from the known gap (Config::gap) with the accepted
+  // model at the AGC's balance.
   double pump_d_phi_rad_s(double theta_A_rad) const {
-    if (config_.gap.known() && !gap_refuted_) {
-      return has_model_
-                 ? known_gap_drift_rad_s(model_, config_.gap.eps_p, config_.gap.eps_q, theta_A_rad)
-                 : 0.0;
-    }
-    return pump_.usable() ? pump_.d_phi_rad_s(theta_A_rad) : 0.0;
+    if (pump_.usable()) return pump_.d_phi_rad_s(theta_A_rad);
+    if (config_.gap.known() && !gap_refuted_ && has_model_)
+      return known_gap_drift_rad_s(model_, config_.gap.eps_p, config_.gap.eps_q, theta_A_rad);
+    return 0.0;
+  }
+  // The known gap gives the pump's part of D_Phi now: in the calibration,
+  // not refuted, a model to scale it, and no usable online fit yet.
+  bool known_gap_in_use() const {
+    return config_.gap.known() && !gap_refuted_ && has_model_ && !pump_.usable();
   }
   // A calibration's gap harmonic (both zero: not known). Keeps everything fitted.
   // A new gap is on trial again (check_known_gap).
