@@ -15,6 +15,23 @@
 using namespace hrg::est;
 using namespace hrg::est::test;
 
+namespace {
+// 16 noise-free 1 s windows of the model p, one every 10 s, spread evenly
+// over the 4theta circle: enough for the estimator to accept p.
+void fold_spread_windows(Estimator& est, const ParamVector& p, std::mt19937_64& rng) {
+  const SyntheticDecay gen{p, 0.554, 0.0};
+  for (int k = 0; k < 16; ++k) {
+    DecayState s{10.0 * k, 1.0, 0.0, 0.05 + k * M_PI / 32};
+    est.begin_window(s.t_s);
+    for (int i = 0; i < 1000; ++i) {
+      gen.step(s, 1e-3);
+      est.add_sample(gen.measure(s, 0.0, rng));
+    }
+    CHECK(est.end_window() == Status::ok);
+  }
+}
+}  // namespace
+
 TEST_GROUP(DriftModel) { ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180); };
 
 TEST(DriftModel, ResonatorDriftIsEquation6WithEquation7AsItsFirstOrder) {
@@ -142,19 +159,10 @@ TEST(ControlDrift, EstimatorFacadeGivesNoDriftBeforeAModel) {
 TEST(ControlDrift, EstimatorDriftAndDPhiIntegrateToTheirCorrections) {
   // GIVEN an estimator with an accepted model (16 noise-free windows)
   const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
-  SyntheticDecay gen{p, 0.554, 0.0};
   Estimator::Config cfg;
   Estimator est{cfg};
   std::mt19937_64 rng(1);
-  for (int k = 0; k < 16; ++k) {
-    DecayState s{10.0 * k, 1.0, 0.0, 0.05 + k * M_PI / 32};
-    est.begin_window(s.t_s);
-    for (int i = 0; i < 1000; ++i) {
-      gen.step(s, 1e-3);
-      est.add_sample(gen.measure(s, 0.0, rng));
-    }
-    CHECK(est.end_window() == Status::ok);
-  }
+  fold_spread_windows(est, p, rng);
   CHECK(est.solve_and_accept().accepted());
   CHECK(est.has_model());
   // AND the loops show a constant D_Phi: a quadrature forcer with an
@@ -434,22 +442,13 @@ TEST(ControlDrift, ALostPumpDriftIsReported) {
   // GIVEN an estimator with an accepted model (16 noise-free windows) whose
   // pump fit forgets in 30 s
   const ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
-  SyntheticDecay gen{p, 0.554, 0.0};
   Estimator::Config cfg;
   cfg.pump.pump_lag_samples = 3;
   cfg.pump.forgetting_time_s = 30.0;
   cfg.pump.max_kappa_2 = 10.0;
   Estimator est{cfg};
   std::mt19937_64 rng(1);
-  for (int k = 0; k < 16; ++k) {
-    DecayState s{10.0 * k, 1.0, 0.0, 0.05 + k * M_PI / 32};
-    est.begin_window(s.t_s);
-    for (int i = 0; i < 1000; ++i) {
-      gen.step(s, 1e-3);
-      est.add_sample(gen.measure(s, 0.0, rng));
-    }
-    CHECK(est.end_window() == Status::ok);
-  }
+  fold_spread_windows(est, p, rng);
   CHECK(est.solve_and_accept().accepted());
   // AND the pump with a gap harmonic on a turning pattern, the amplitude
   // read with 1e-6 V of noise (the batch fits scatter)

@@ -166,6 +166,16 @@ double gap_drift_dph(const Run& run, const Resonator& res) {
   return run.j.sim.resonator.nu_per_s() * std::hypot(res.eps_p, res.eps_q) / 2.0 /
          run.j.firmware.gyro.angular_gain * kRadSToDph;
 }
+// Checks every park the firmware calls valid against tol_dph; their count.
+std::size_t check_valid_parks_within(const RunResult& r, double tol_dph) {
+  std::size_t valid = 0;
+  for (const hrg::sim_run::ParkResult& p : r.parks) {
+    if (!p.model_valid) continue;
+    ++valid;
+    CHECK(std::fabs(p.bias_comp_dph) < tol_dph);
+  }
+  return valid;
+}
 void print_parks(const RunResult& r) {
   for (const hrg::sim_run::ParkResult& p : r.parks)
     std::printf("\n    park %7.2f deg: raw %+9.3f comp %+9.3f deg/h, valid %d",
@@ -187,14 +197,9 @@ TEST(ChartDPhi, AGapHarmonicStaysCompensatedWhileTheParksSitAtOneAngle) {
   // the gap's drift (~88 deg/h here; the pump fit withdrawn, as it was when
   // its 3x3 grew ill-conditioned at the equilibrium angle, left -63 deg/h)
   // and never worse than raw
-  const double tol_dph = 0.02 * gap_drift_dph(run, res);
-  std::size_t valid = 0;
-  for (const hrg::sim_run::ParkResult& p : run.r.parks) {
-    if (!p.model_valid) continue;
-    ++valid;
-    CHECK(std::fabs(p.bias_comp_dph) < tol_dph);
-    CHECK(std::fabs(p.bias_comp_dph) <= std::fabs(p.bias_raw_dph));
-  }
+  const std::size_t valid = check_valid_parks_within(run.r, 0.02 * gap_drift_dph(run, res));
+  for (const hrg::sim_run::ParkResult& p : run.r.parks)
+    if (p.model_valid) CHECK(std::fabs(p.bias_comp_dph) <= std::fabs(p.bias_raw_dph));
   CHECK(valid >= 8);
 }
 
@@ -207,13 +212,7 @@ TEST(ChartDPhi, APumpDriftThatIsWithdrawnMakesTheCompensationNotValid) {
   CHECK_FALSE(run.pump.usable);
   // THEN the parks whose output lacks the pump's drift are not called valid:
   // every valid park is compensated to within 2 % of the gap's drift
-  const double tol_dph = 0.02 * gap_drift_dph(run, res);
-  std::size_t valid = 0;
-  for (const hrg::sim_run::ParkResult& p : run.r.parks) {
-    if (!p.model_valid) continue;
-    ++valid;
-    CHECK(std::fabs(p.bias_comp_dph) < tol_dph);
-  }
+  const std::size_t valid = check_valid_parks_within(run.r, 0.02 * gap_drift_dph(run, res));
   // AND the firmware does not stand behind the output at the end
   CHECK(valid < run.r.parks.size());
   CHECK_FALSE(run.r.compensation_valid);
