@@ -19,8 +19,9 @@ foreach(type q31 f32 f64)
     set(q31_ir ${per_frame_x100})
   endif()
 endforeach()
-# Whole chain per call (one block): what the firmware's base frame pays.
-foreach(type q31 f32)
+# Whole chain per call (one block): what the firmware's base frame pays;
+# `_cal`: with the electronics correction (pickoff map inverse, feedthrough) in force.
+foreach(type q31 f32 q31_cal f32_cal)
   hrg_callgrind_count(ir chain.${type} hrg_bench_chain_${type} chain_${type} ${blocks})
   math(EXPR per_block "${ir} / ${blocks}")
   math(EXPR per_frame "${ir} / ${frames}")

@@ -17,3 +17,5 @@ count(selfcal_sample hrg_bench_selfcal_sample 4 12000 "pickoff self-calibration 
 count(selfcal_solve hrg_bench_selfcal_solve 100 100 "pickoff self-calibration solve (5x5, after each window)")
 count(modelcheck_sample hrg_bench_modelcheck_sample 4 12000 "damping model check add_sample (1 kHz, in windows)")
 count(modelcheck_solve hrg_bench_modelcheck_solve 100 100 "damping model check solve (4x4, after each window)")
+count(pumpdrift_sample hrg_bench_pumpdrift_sample 60000 60000 "pump drift fit add_sample + d_phi (1 kHz, excitation on; folds every 10 s)")
+count(knowngap_step hrg_bench_knowngap_step 10000 10000 "KnownGapDrift::step (1 kHz, known gap's D_Phi)")

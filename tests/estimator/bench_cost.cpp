@@ -3,7 +3,7 @@
 // instructions inside each hrg_bench_est_* function and divides by its count).
 //   bench_estimator_cost <op> <count>
 //   op: sample | window | solve | solve_alt | output | selfcal_sample | selfcal_solve |
-//       modelcheck_sample | modelcheck_solve
+//       modelcheck_sample | modelcheck_solve | pumpdrift_sample | knowngap_step
 #include <estimator/damping_model_check.hpp>
 #include <estimator/estimator.hpp>
 #include <estimator/pickoff_self_calibration.hpp>
@@ -41,6 +41,9 @@ void hrg_bench_selfcal_sample(PickoffSelfCalibration& cal, const WaveSample* s, 
 PickoffSelfCalResult hrg_bench_selfcal_solve(const PickoffSelfCalibration& cal);
 void hrg_bench_modelcheck_sample(DampingModelCheck& c, const WaveSample* s, int n);
 DampingModelCheckResult hrg_bench_modelcheck_solve(const DampingModelCheck& c);
+double hrg_bench_pumpdrift_sample(PumpDriftEstimator& f, const PumpDriftEstimator::Sample* s,
+                                  int n);
+double hrg_bench_knowngap_step(KnownGapDrift& g, const ParamVector& p, int n);
 }
 
 namespace {
@@ -105,6 +108,35 @@ int run_model_check(const char* op, int count) {
   std::printf("%s %d %.3e\n", op, count, sink);
   return 0;
 }
+
+// The pump's drift fit on the control-rate rows while the excitation is on:
+// a pump beside a turning pattern (segments folded every 10 s, the fit's
+// figures refreshed after each fold), 1 kHz rows.
+int run_pump_drift(int count) {
+  PumpDriftEstimator::Config cfg;
+  cfg.pump_lag_samples = 3;
+  PumpDriftEstimator fit(cfg);
+  fit.set_model(seed_params(0.2, 0.5));
+  std::vector<PumpDriftEstimator::Sample> rows(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    auto& r = rows[static_cast<std::size_t>(i)];
+    r.t_s = 1e-3 * i;
+    r.theta_A_rad = 0.3 * r.t_s;
+    r.a_A_v = 1.0 + 1e-4 * std::sin(0.7 * r.t_s);
+    r.a_B_v = 1e-3;
+    r.pump_v = 2.0 + 0.01 * std::cos(4.0 * r.theta_A_rad);
+  }
+  const double sink = hrg_bench_pumpdrift_sample(fit, rows.data(), count);
+  std::printf("pumpdrift_sample %d %.3e\n", count, sink);
+  return 0;
+}
+
+int run_known_gap(int count) {
+  KnownGapDrift gap;
+  const double sink = hrg_bench_knowngap_step(gap, seed_params(0.2, 0.5), count);
+  std::printf("knowngap_step %d %.3e\n", count, sink);
+  return 0;
+}
 }  // namespace
 
 extern "C" {
@@ -143,6 +175,27 @@ __attribute__((noipa)) DampingModelCheckResult hrg_bench_modelcheck_solve(
     const DampingModelCheck& c) {
   return c.solve();
 }
+// The pump's drift fit per row (segment folds and refreshes included) and
+// the known gap's D_Phi per output sample.
+__attribute__((noipa)) double hrg_bench_pumpdrift_sample(PumpDriftEstimator& f,
+                                                         const PumpDriftEstimator::Sample* s,
+                                                         int n) {
+  double d = 0;
+  for (int i = 0; i < n; ++i) {
+    f.add_sample(s[i]);
+    d += f.d_phi_rad_s(s[i].theta_A_rad);
+  }
+  return d;
+}
+__attribute__((noipa)) double hrg_bench_knowngap_step(KnownGapDrift& g, const ParamVector& p,
+                                                      int n) {
+  double d = 0;
+  for (int i = 0; i < n; ++i) {
+    const double t_s = 1e-3 * i;
+    d += g.step(p, 0.02, 0.01, t_s, 0.3 * t_s, 1.0 - 1e-5 * t_s, 1e-3, 1.0);
+  }
+  return d;
+}
 __attribute__((noipa)) double hrg_bench_est_output(DriftCompensator& comp, int n) {
   double c = 0;
   for (int i = 0; i < n; ++i)
@@ -155,7 +208,7 @@ int main(int argc, char** argv) {
   if (argc != 3) {
     std::fprintf(stderr,
                  "usage: %s sample|window|solve|solve_alt|output|selfcal_sample|selfcal_solve|"
-                 "modelcheck_sample|modelcheck_solve <count>\n",
+                 "modelcheck_sample|modelcheck_solve|pumpdrift_sample|knowngap_step <count>\n",
                  argv[0]);
     return 2;
   }
@@ -163,6 +216,8 @@ int main(int argc, char** argv) {
   const int count = std::atoi(argv[2]);
   if (std::strncmp(op, "selfcal", 7) == 0) return run_self_calibration(op, count);
   if (std::strncmp(op, "modelcheck", 10) == 0) return run_model_check(op, count);
+  if (std::strcmp(op, "pumpdrift_sample") == 0) return run_pump_drift(count);
+  if (std::strcmp(op, "knowngap_step") == 0) return run_known_gap(count);
   // A well-covered state to solve: 16 windows.
   NormalEquations ls;
   WindowAccumulator acc;
