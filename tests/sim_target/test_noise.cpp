@@ -78,8 +78,7 @@ TEST(Gaussian, MomentsTailsAndHistogramAreTheNormalOnes) {
 
 TEST(Gaussian, StreamGivesTheSameDrawsAsNormalInTurn) {
   // 1e5 draws (about 1200 wedges or tail draws, which go back through the
-  // generator), started with a refill's leftovers in the buffer and with
-  // normal() and fill() between the streams.
+  // generator), with normal() and fill() between the streams.
   hrg::sim::detail::Gaussian a(11);
   hrg::sim::detail::Gaussian b(11);
   double block[300];

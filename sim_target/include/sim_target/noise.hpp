@@ -22,11 +22,8 @@
 // its floating-point work (the resonator's step): this leaves the draws to the integer units but
 // for one conversion and one product.
 //
-// Draws are made in blocks of kBlock into a buffer that normal() and fill()
-// hand out in turn: the generator's state stays in registers over a block
-// and the consumer pays a load per normal. The sequence is the one the
-// ziggurat gives draw by draw (buffering changes when a normal is computed,
-// not which one), so block boundaries and call patterns do not change bits.
+// normal() and fill() draw one normal at a time; Stream gives the same
+// sequence with the generator's state in registers over a loop.
 
 #include <algorithm>
 #include <array>
@@ -42,7 +39,6 @@ class Gaussian {
   explicit Gaussian(uint64_t seed = 1) { reseed(seed); }
 
   void reseed(uint64_t seed) {
-    pos_ = kBlock;  // the buffer is refilled from the new state
     for (auto& s : s_) {
       seed += 0x9E3779B97F4A7C15ull;
       uint64_t z = seed;
@@ -55,10 +51,7 @@ class Gaussian {
   // Uniform in (0, 1).
   double uniform() { return to_unit(next_bits()); }
 
-  double normal() {
-    if (pos_ == kBlock) refill();
-    return buf_[pos_++];
-  }
+  double normal() { return draw(*z_); }
 
  private:
   struct Layers;
@@ -67,17 +60,15 @@ class Gaussian {
   // The same sequence as normal(), for one tight loop that interleaves the
   // draws with other work (one sample at a time): the generator's state is
   // copied into the stream, where it can live in registers, so that its
-  // chain overlaps that work's. What a refill left in the buffer comes
-  // first; the ziggurat's rectangle test is inline, the wedges and the tail
-  // (1.2 % of the draws) go through the generator itself. commit() hands
+  // chain overlaps that work's. The ziggurat's rectangle test is inline,
+  // the wedges and the tail (1.2 % of the draws) go through the generator
+  // itself. commit() hands
   // the state back; the generator must not be used before it.
   class Stream {
    public:
     explicit Stream(Gaussian& g)
-        : g_(g), z_(g.z_), pos_(g.pos_), s0_(g.s_[0]), s1_(g.s_[1]), s2_(g.s_[2]), s3_(g.s_[3]) {}
+        : g_(g), z_(g.z_), s0_(g.s_[0]), s1_(g.s_[1]), s2_(g.s_[2]), s3_(g.s_[3]) {}
     [[gnu::always_inline]] double normal() {
-      if (pos_ < kBlock) [[unlikely]]
-        return g_.buf_[pos_++];
       const uint64_t r = rotl(s1_ * 5, 7) * 9;  // xoshiro256**, as next_bits()
       const uint64_t t = s1_ << 17;
       s2_ ^= s0_;
@@ -103,30 +94,22 @@ class Gaussian {
       g_.s_[1] = s1_;
       g_.s_[2] = s2_;
       g_.s_[3] = s3_;
-      g_.pos_ = pos_;
     }
 
    private:
     Gaussian& g_;
     const Layers* z_;
-    std::size_t pos_;
     uint64_t s0_, s1_, s2_, s3_;
   };
 
   // n normals into out, in the order normal() would give them.
   void fill(double* out, std::size_t n) {
-    while (n > 0) {
-      if (pos_ == kBlock) refill();
-      const std::size_t take = std::min(n, kBlock - pos_);
-      std::copy_n(buf_.data() + pos_, take, out);
-      pos_ += take;
-      out += take;
-      n -= take;
-    }
+    const Layers& z = *z_;
+    for (std::size_t k = 0; k < n; ++k)
+      out[k] = draw(z);
   }
 
  private:
-  static constexpr std::size_t kBlock = 256;  // normals per refill
   static constexpr std::size_t kLayers = 128;
   static constexpr double kTailStart = 3.442619855899;       // r: where the tail begins
   static constexpr double kLayerArea = 9.91256303526217e-3;  // area of each layer
@@ -203,13 +186,6 @@ class Gaussian {
     return draw(*z_);
   }
 
-  void refill() {
-    const Layers& z = layers();
-    for (auto& v : buf_)
-      v = draw(z);
-    pos_ = 0;
-  }
-
   // Marsaglia's tail beyond r: exact, by rejection from an exponential.
   double tail(bool negative) {
     double x = 0.0;
@@ -251,8 +227,6 @@ class Gaussian {
 
   uint64_t s_[4]{};
   const Layers* z_ = &layers();
-  std::array<double, kBlock> buf_{};
-  std::size_t pos_ = kBlock;
 };
 
 }  // namespace hrg::sim::detail
