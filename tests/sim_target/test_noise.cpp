@@ -5,6 +5,7 @@
 // errors of each statistic for N draws (the seed is fixed, so the test is deterministic).
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "sim_target/noise.hpp"
@@ -77,8 +78,7 @@ TEST(Gaussian, MomentsTailsAndHistogramAreTheNormalOnes) {
 
 TEST(Gaussian, StreamGivesTheSameDrawsAsNormalInTurn) {
   // 1e5 draws (about 1200 wedges or tail draws, which go back through the
-  // generator), started with a refill's leftovers in the buffer and with
-  // normal() and fill() between the streams.
+  // generator), with normal() and fill() between the streams.
   hrg::sim::detail::Gaussian a(11);
   hrg::sim::detail::Gaussian b(11);
   double block[300];
@@ -106,4 +106,42 @@ TEST(Gaussian, FillGivesTheSameDrawsAsNormalInTurn) {
   a.fill(block, 1000);
   for (double v : block)
     CHECK_EQUAL(b.normal(), v);
+}
+
+TEST(Gaussian, TheIntegerAbscissaIsTheFloatingPointOne) {
+  // The ziggurat's abscissa u = 2 ((j + 1/2) 2^-53) - 1 (j the draw's top
+  // 53 bits, j + 1/2 rounded to even from 2^52 on) in units of 2^-53: equal
+  // to u exactly, at the edges of both halves and for 1e6 draws; so the
+  // integer rectangle test and product give the floating-point ones' bits.
+  const auto u_of = [](uint64_t r) {
+    const double t = (static_cast<double>(r >> 11) + 0.5) * 0x1.0p-53;
+    return 2.0 * t - 1.0;
+  };
+  const auto check = [&](uint64_t r) {
+    const int64_t m = hrg::sim::detail::Gaussian::abscissa_units(r);
+    CHECK_EQUAL(u_of(r), static_cast<double>(m) * 0x1p-53);
+  };
+  const uint64_t edges[] = {0,
+                            (uint64_t{1} << 11) - 1,
+                            uint64_t{1} << 11,
+                            ((uint64_t{1} << 52) - 1) << 11,
+                            uint64_t{1} << 63,
+                            (uint64_t{1} << 63) | (uint64_t{1} << 11),
+                            (uint64_t{1} << 63) | (uint64_t{2} << 11),
+                            ~uint64_t{0},
+                            ~uint64_t{0} << 11};
+  for (const uint64_t r : edges)
+    check(r);
+  // u = -1 + 2^-53, 0 (j = 2^52) and 1 (j = 2^53 - 1, rounded up) exactly.
+  LONGS_EQUAL(1 - (int64_t{1} << 53), hrg::sim::detail::Gaussian::abscissa_units(0));
+  LONGS_EQUAL(0, hrg::sim::detail::Gaussian::abscissa_units(uint64_t{1} << 63));
+  LONGS_EQUAL(int64_t{1} << 53, hrg::sim::detail::Gaussian::abscissa_units(~uint64_t{0}));
+  uint64_t x = 0x243F6A8885A308D3ull;  // splitmix64 over a fixed seed
+  for (int k = 0; k < 1'000'000; ++k) {
+    x += 0x9E3779B97F4A7C15ull;
+    uint64_t z = x;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    check(z ^ (z >> 31));
+  }
 }

@@ -14,17 +14,23 @@
 // One draw feeds both the layer (its low 7 bits) and the abscissa (its top 53
 // bits), which do not overlap.
 //
-// Draws are made in blocks of kBlock into a buffer that normal() and fill()
-// hand out in turn: the generator's state stays in registers over a block
-// and the consumer pays a load per normal. The sequence is the one the
-// ziggurat gives draw by draw (buffering changes when a normal is computed,
-// not which one), so block boundaries and call patterns do not change bits.
+// The rectangle test is made on integers, with the same outcome and the same
+// normal: the abscissa u = 2 ((j + 1/2) 2^-53) - 1 (j the top 53 bits) is
+// m 2^-53 for the integer m of abscissa_units() (which follows the one
+// rounding in it), so |u| < ratio[i] is |m| < ceil(ratio[i] 2^53)
+// (Layers::inside()) and u x[i] is m (x[i] 2^-53), the same product. The board's loop is bound by
+// its floating-point work (the resonator's step): this leaves the draws to the integer units but
+// for one conversion and one product.
+//
+// normal() and fill() draw one normal at a time; Stream gives the same
+// sequence with the generator's state in registers over a loop.
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 namespace hrg::sim::detail {
 
@@ -33,7 +39,6 @@ class Gaussian {
   explicit Gaussian(uint64_t seed = 1) { reseed(seed); }
 
   void reseed(uint64_t seed) {
-    pos_ = kBlock;  // the buffer is refilled from the new state
     for (auto& s : s_) {
       seed += 0x9E3779B97F4A7C15ull;
       uint64_t z = seed;
@@ -46,10 +51,7 @@ class Gaussian {
   // Uniform in (0, 1).
   double uniform() { return to_unit(next_bits()); }
 
-  double normal() {
-    if (pos_ == kBlock) refill();
-    return buf_[pos_++];
-  }
+  double normal() { return draw(*z_); }
 
  private:
   struct Layers;
@@ -58,17 +60,15 @@ class Gaussian {
   // The same sequence as normal(), for one tight loop that interleaves the
   // draws with other work (one sample at a time): the generator's state is
   // copied into the stream, where it can live in registers, so that its
-  // chain overlaps that work's. What a refill left in the buffer comes
-  // first; the ziggurat's rectangle test is inline, the wedges and the tail
-  // (1.2 % of the draws) go through the generator itself. commit() hands
+  // chain overlaps that work's. The ziggurat's rectangle test is inline,
+  // the wedges and the tail (1.2 % of the draws) go through the generator
+  // itself. commit() hands
   // the state back; the generator must not be used before it.
   class Stream {
    public:
     explicit Stream(Gaussian& g)
-        : g_(g), z_(g.z_), pos_(g.pos_), s0_(g.s_[0]), s1_(g.s_[1]), s2_(g.s_[2]), s3_(g.s_[3]) {}
+        : g_(g), z_(g.z_), s0_(g.s_[0]), s1_(g.s_[1]), s2_(g.s_[2]), s3_(g.s_[3]) {}
     [[gnu::always_inline]] double normal() {
-      if (pos_ < kBlock) [[unlikely]]
-        return g_.buf_[pos_++];
       const uint64_t r = rotl(s1_ * 5, 7) * 9;  // xoshiro256**, as next_bits()
       const uint64_t t = s1_ << 17;
       s2_ ^= s0_;
@@ -77,12 +77,12 @@ class Gaussian {
       s0_ ^= s3_;
       s2_ ^= t;
       s3_ = rotl(s3_, 45);
-      const double u = 2.0 * to_unit(r) - 1.0;  // (-1, 1), as in draw()
+      const int64_t m = abscissa_units(r);  // as in draw()
       const auto i = static_cast<std::size_t>(r & (kLayers - 1));
-      if (std::fabs(u) < z_->ratio[i]) [[likely]]
-        return u * z_->x[i];
+      if (z_->inside(m, i)) [[likely]]
+        return static_cast<double>(m) * z_->x_unit[i];
       commit();
-      const double v = g_.finish(u, i);
+      const double v = g_.finish(m, i);
       s0_ = g_.s_[0];
       s1_ = g_.s_[1];
       s2_ = g_.s_[2];
@@ -94,39 +94,43 @@ class Gaussian {
       g_.s_[1] = s1_;
       g_.s_[2] = s2_;
       g_.s_[3] = s3_;
-      g_.pos_ = pos_;
     }
 
    private:
     Gaussian& g_;
     const Layers* z_;
-    std::size_t pos_;
     uint64_t s0_, s1_, s2_, s3_;
   };
 
   // n normals into out, in the order normal() would give them.
   void fill(double* out, std::size_t n) {
-    while (n > 0) {
-      if (pos_ == kBlock) refill();
-      const std::size_t take = std::min(n, kBlock - pos_);
-      std::copy_n(buf_.data() + pos_, take, out);
-      pos_ += take;
-      out += take;
-      n -= take;
-    }
+    const Layers& z = *z_;
+    for (std::size_t k = 0; k < n; ++k)
+      out[k] = draw(z);
   }
 
  private:
-  static constexpr std::size_t kBlock = 256;  // normals per refill
   static constexpr std::size_t kLayers = 128;
   static constexpr double kTailStart = 3.442619855899;       // r: where the tail begins
   static constexpr double kLayerArea = 9.91256303526217e-3;  // area of each layer
 
   // x[i]: right edge of layer i's rectangle (x[0] = V / f(r), the base layer
-  // with the tail folded in; x[128] = 0); ratio[i] = x[i+1] / x[i].
+  // with the tail folded in; x[128] = 0); ratio[i] = x[i+1] / x[i];
+  // x_unit[i] = x[i] 2^-53 (a power of two: exact). With T = ceil(ratio[i]
+  // 2^53), the least |m| outside (exact: ratio[i] 2^53 is a double,
+  // integral or not), |m| < T is m + T - 1 < 2 T - 1 taken unsigned (no
+  // branch or absolute value): offset[i] = T - 1, span[i] = 2 T - 1, and 0
+  // for the top layer's T = 0 (ratio 0: always outside).
   struct Layers {
     std::array<double, kLayers + 1> x{};
     std::array<double, kLayers> ratio{};
+    std::array<double, kLayers> x_unit{};
+    std::array<uint64_t, kLayers> offset{};
+    std::array<uint64_t, kLayers> span{};
+    std::array<double, kLayers + 1> density{};  // exp(-x[i]^2 / 2) at each edge
+    bool inside(int64_t m, std::size_t i) const {
+      return static_cast<uint64_t>(m) + offset[i] < span[i];
+    }
     Layers() {
       double f = std::exp(-0.5 * kTailStart * kTailStart);
       x[0] = kLayerArea / f;
@@ -136,8 +140,15 @@ class Gaussian {
         x[i] = std::sqrt(-2.0 * std::log(kLayerArea / x[i - 1] + f));
         f = std::exp(-0.5 * x[i] * x[i]);
       }
-      for (std::size_t i = 0; i < kLayers; ++i)
+      for (std::size_t i = 0; i < kLayers; ++i) {
         ratio[i] = x[i + 1] / x[i];
+        const auto t = static_cast<uint64_t>(std::ceil(ratio[i] * 0x1p53));
+        offset[i] = t - 1;
+        span[i] = t > 0 ? 2 * t - 1 : 0;
+        x_unit[i] = x[i] * 0x1p-53;
+      }
+      for (std::size_t i = 0; i <= kLayers; ++i)
+        density[i] = std::exp(-0.5 * x[i] * x[i]);
     }
   };
   static const Layers& layers() {
@@ -149,34 +160,30 @@ class Gaussian {
   double draw(const Layers& z) {
     for (;;) {
       const uint64_t r = next_bits();
-      const double u = 2.0 * to_unit(r) - 1.0;  // (-1, 1)
+      const int64_t m = abscissa_units(r);  // u = m 2^-53 in [-1, 1]
       const auto i = static_cast<std::size_t>(r & (kLayers - 1));
-      if (std::fabs(u) < z.ratio[i]) return u * z.x[i];  // inside the layer's rectangle
-      if (i == 0) return tail(u < 0.0);
-      // The wedge between the rectangle and the density: accept against f itself.
-      const double x = u * z.x[i];
-      const double f0 = std::exp(-0.5 * (z.x[i] * z.x[i] - x * x));
-      const double f1 = std::exp(-0.5 * (z.x[i + 1] * z.x[i + 1] - x * x));
-      if (f1 + uniform() * (f0 - f1) < 1.0) return x;
+      if (z.inside(m, i)) return static_cast<double>(m) * z.x_unit[i];  // in the rectangle
+      if (const auto v = outside(z, m, i)) return *v;
     }
   }
-  // draw() after a draw (u, layer i) fell outside its rectangle: the tail or
-  // the wedge's test, then draw() again if rejected (the same sequence).
-  [[gnu::noinline]] double finish(double u, std::size_t i) {
-    const Layers& z = *z_;
+  // A draw (u = m 2^-53, layer i) outside its layer's rectangle: the tail
+  // (layer 0), or the wedge between the rectangle and the density, accepted
+  // against the density itself: f(x[i+1]) + U (f(x[i]) - f(x[i+1])) <
+  // f(x), with f(x) = exp(-x^2/2), one exp per wedge. None when rejected.
+  std::optional<double> outside(const Layers& z, int64_t m, std::size_t i) {
+    const double u = static_cast<double>(m) * 0x1p-53;
     if (i == 0) return tail(u < 0.0);
     const double x = u * z.x[i];
-    const double f0 = std::exp(-0.5 * (z.x[i] * z.x[i] - x * x));
-    const double f1 = std::exp(-0.5 * (z.x[i + 1] * z.x[i + 1] - x * x));
-    if (f1 + uniform() * (f0 - f1) < 1.0) return x;
-    return draw(z);
+    const double f0 = z.density[i];
+    const double f1 = z.density[i + 1];
+    if (f1 + uniform() * (f0 - f1) < std::exp(-0.5 * x * x)) return x;
+    return std::nullopt;
   }
-
-  void refill() {
-    const Layers& z = layers();
-    for (auto& v : buf_)
-      v = draw(z);
-    pos_ = 0;
+  // draw() after a draw fell outside its rectangle: outside(), then draw()
+  // again if rejected (the same sequence).
+  [[gnu::noinline]] double finish(int64_t m, std::size_t i) {
+    if (const auto v = outside(*z_, m, i)) return *v;
+    return draw(*z_);
   }
 
   // Marsaglia's tail beyond r: exact, by rejection from an exponential.
@@ -191,6 +198,20 @@ class Gaussian {
   }
 
   static double to_unit(uint64_t r) { return (static_cast<double>(r >> 11) + 0.5) * 0x1.0p-53; }
+
+ public:
+  // 2 to_unit(r) - 1 in units of 2^-53, exactly: with j = r >> 11, j + 1/2
+  // is exact below 2^52 (m = 2 j + 1 - 2^53) and rounds to the even
+  // neighbour above it (m = 2 (j + (j & 1)) - 2^53); the product and the
+  // subtraction after it are exact. |m| <= 2^53, so double(m) is exact too.
+  static int64_t abscissa_units(uint64_t r) {
+    const uint64_t j = r >> 11;
+    const uint64_t high = j >> 52;         // 1 when j >= 2^52
+    const uint64_t even = j + (j & high);  // j + 1/2 rounded, above 2^52 (less 1/2)
+    return static_cast<int64_t>(2 * even + 1 - high) - (int64_t{1} << 53);
+  }
+
+ private:
   static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
   uint64_t next_bits() {
     const uint64_t result = rotl(s_[1] * 5, 7) * 9;
@@ -206,8 +227,6 @@ class Gaussian {
 
   uint64_t s_[4]{};
   const Layers* z_ = &layers();
-  std::array<double, kBlock> buf_{};
-  std::size_t pos_ = kBlock;
 };
 
 }  // namespace hrg::sim::detail

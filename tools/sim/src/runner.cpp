@@ -321,9 +321,69 @@ void summarise_identification(RunResult& r, const RunConfig& job,
   }
 }
 
+// The calling thread's CPU time (runs in parallel threads each count their own).
+uint64_t thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+// The simulated target's share of the lockstep run by CPU time, robust to a
+// loaded machine. The firmware times Adc::read_block on the host's steady
+// clock, so a preemption inside a block counts as the target's and one
+// outside it as the firmware's: with a few long preemptions per run the
+// wall-clock share moves by several percent. Reading the thread's CPU clock
+// around every block would settle that, but a read is a system call (2.6 us
+// in a virtual machine, where a whole block takes about 3.5 us). So the run
+// is cut into stretches of kStretchFrames blocks with one CPU-clock read
+// each (about 0.6 % of the run): a stretch whose CPU time equals its wall time (to
+// kPreemptedFraction) ran without being preempted, and there the steady clock's split between the
+// target and the rest is a split of CPU time. The share is taken over those stretches; on an idle
+// machine they are all of them.
+class TargetShare {
+ public:
+  static constexpr uint64_t kStretchFrames = 128;
+  static constexpr double kPreemptedFraction = 0.02;
+
+  explicit TargetShare(const hal::MonotonicClock& wall) : wall_(wall) {}
+  void start(uint64_t adc_wait_ns) { mark(adc_wait_ns); }
+  // After the stretch's last frame.
+  void close_stretch(uint64_t adc_wait_ns) {
+    const uint64_t wall0 = wall_ns_, cpu0 = cpu_ns_, wait0 = wait_ns_;
+    const uint64_t wall1 = wall_.now_ns();
+    mark(adc_wait_ns);
+    const auto wall = static_cast<double>(wall1 - wall0);
+    const auto cpu = static_cast<double>(cpu_ns_ - cpu0);
+    ++stretches_;
+    if (wall - cpu > kPreemptedFraction * wall) return;
+    ++kept_;
+    kept_wall_ns_ += wall;
+    kept_target_ns_ += static_cast<double>(wait_ns_ - wait0);
+  }
+  // Negative when no stretch ran unpreempted (or none closed). The CPU
+  // interval holds one read more than the wall interval, never less.
+  double share() const { return kept_wall_ns_ > 0 ? kept_target_ns_ / kept_wall_ns_ : -1.0; }
+  double kept_fraction() const {
+    return stretches_ ? static_cast<double>(kept_) / static_cast<double>(stretches_) : 0.0;
+  }
+
+ private:
+  // The stretch's wall time starts after the CPU clock's read, so that the
+  // read's own cost is not counted against the firmware.
+  void mark(uint64_t adc_wait_ns) {
+    cpu_ns_ = thread_cpu_ns();
+    wall_ns_ = wall_.now_ns();
+    wait_ns_ = adc_wait_ns;
+  }
+  const hal::MonotonicClock& wall_;
+  uint64_t wall_ns_ = 0, cpu_ns_ = 0, wait_ns_ = 0;
+  uint64_t stretches_ = 0, kept_ = 0;
+  double kept_wall_ns_ = 0.0, kept_target_ns_ = 0.0;
+};
+
 // Speed of the run: wall and CPU time, the share spent in the simulation.
 void summarise_speed(RunResult& r, const fw::Gyro& gyro, uint64_t frames, double wall_s,
-                     double cpu_s) {
+                     double cpu_s, const TargetShare& share) {
   r.wall_s = wall_s;
   r.cpu_s = cpu_s;
   r.realtime_factor = r.wall_s > 0 ? r.sim_s / r.wall_s : 0.0;
@@ -331,6 +391,8 @@ void summarise_speed(RunResult& r, const fw::Gyro& gyro, uint64_t frames, double
   const auto adc_wait_ns = static_cast<double>(gyro.status().adc_wait_ns);
   r.adc_wait_mean_us = frames ? adc_wait_ns * 1e-3 / static_cast<double>(frames) : 0.0;
   r.sim_share = r.wall_s > 0 ? adc_wait_ns * 1e-9 / r.wall_s : 0.0;
+  r.sim_share_cpu = share.share();
+  r.share_stretches_kept = share.kept_fraction();
 }
 
 }  // namespace
@@ -354,7 +416,9 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.rows.reserve(frames / row_every + 1);
   ProgressBar bar(static_cast<double>(frames), opt.progress);
   const auto wall0 = std::chrono::steady_clock::now();
-  const std::clock_t cpu0 = std::clock();
+  const uint64_t cpu0_ns = thread_cpu_ns();
+  TargetShare share(rig.host_timer);
+  share.start(gyro.status().adc_wait_ns);
   std::size_t next_fault = 0;
   fw::Mode last_mode = fw::Mode::power_up;
   uint32_t solves_seen = 0;
@@ -369,6 +433,8 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   for (uint64_t k = 0; k < frames; ++k) {
     inject_faults(job, static_cast<double>(k) / fw::kBaseRateHz, next_fault, target, r);
     firmware->run_frame();
+    if (!opt.real_time && (k + 1) % TargetShare::kStretchFrames == 0)
+      share.close_stretch(gyro.status().adc_wait_ns);
     record_convergence(*firmware, job, solves_seen, r);
     const fw::GyroStatus& st = gyro.status();
     stamp.after_block(*firmware, target, RowStamper::stamped(k, row_every));
@@ -394,7 +460,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.sim_s = job.duration_s;
   summarise_speed(r, gyro, frames,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(),
-                  static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
+                  static_cast<double>(thread_cpu_ns() - cpu0_ns) * 1e-9, share);
   r.final_mode = gyro.status().mode;
   r.compensation_valid = gyro.status().compensation_valid;
   r.compensation_applied = gyro.status().compensation_applied;

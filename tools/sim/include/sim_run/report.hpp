@@ -39,6 +39,12 @@ void write_allan_csv(const std::filesystem::path& path, const RunResult& r);
 // The end-of-run summary table.
 void print_summary(std::FILE* out, const RunConfig& job, const RunResult& r);
 
+// The simulated target's share of a lockstep run, the figure held to the
+// issue-13 goal (by CPU time over the unpreempted stretches) and the
+// wall-clock one beside it, e.g. "38 % by CPU time (97 % of 64-block
+// stretches unpreempted); 41 % by wall time".
+std::string describe_share(const RunResult& r);
+
 // How many parks the compensated bias was measured on (the model valid
 // throughout), since when, and the run length the resonator needs.
 std::string bias_test_coverage(const RunResult& r);

@@ -150,12 +150,16 @@ struct RunResult {
   uint16_t faults_seen = 0;
   double sim_s = 0.0;
   double wall_s = 0.0;
-  double cpu_s = 0.0;                // process CPU time of the loop
+  double cpu_s = 0.0;                // the thread's CPU time in the loop
   double realtime_factor = 0.0;      // simulated s per wall s
   double realtime_factor_cpu = 0.0;  // simulated s per CPU s (what one free core gives)
   double sim_share = 0.0;            // share of the wall time spent in the simulated ADC (physics)
-  double adc_wait_mean_us = 0.0;     // mean time per frame inside Adc::read_block (the simulation)
-  sim::SimStageTimes sim_stages;     // host time per stage of read_block (RunOptions::profile)
+  // The same share by CPU time: over the stretches of the run that the
+  // thread's CPU clock shows ran unpreempted (lockstep; negative if none).
+  double sim_share_cpu = -1.0;
+  double share_stretches_kept = 0.0;  // fraction of the stretches that did
+  double adc_wait_mean_us = 0.0;      // mean time per frame inside Adc::read_block (the simulation)
+  sim::SimStageTimes sim_stages;      // host time per stage of read_block (RunOptions::profile)
   double excitation_off_fraction = 0.0;
   uint32_t windows = 0;
   uint32_t windows_accepted = 0;
