@@ -2,6 +2,7 @@
 #include "audit/audit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -139,10 +140,11 @@ struct Chosen {
   // Set by weigh_findings(): value, 1-sigma (catalogue unit) and the share of
   // the baseline's misfit it removes given everything else (-1: edges).
   double value = 0.0, sigma = 0.0, fraction = 0.0;
-  bool unique_checked = false;     // removed_chi2 from a drop-one refit
-  double unique_dchi = -1.0;       // chi^2 (whitened) it removes given everything else
-  double removed_chi2 = 0.0;       // chi^2 (unwhitened) it removes given everything else
-  double removed_free_chi2 = 0.0;  // the part of removed_chi2 on the free decays
+  bool unique_checked = false;  // removed_chi2 from a drop-one refit
+  double unique_dchi = -1.0;    // chi^2 (whitened) it removes given everything else
+  double removed_chi2 = 0.0;    // chi^2 (unwhitened) it removes given everything else
+  // The parts of removed_chi2 on the observation groups (Auditor::group_chi2).
+  std::array<double, 4> removed_groups{};
 };
 
 // One candidate added to the current model.
@@ -152,6 +154,44 @@ struct Candidate {
   double dbic;
   double value, sigma;
 };
+
+// Per observation group (free decays, the excitation segments' frequency,
+// balance and angle drift): whether the final model leaves structure there,
+// and the baseline's misfit beyond the noise there. The free decays' come
+// from the structure test (their noise is what the final model leaves when
+// no structure is left); an excitation group with kBalanceMinSegments
+// observations or more is left above unexplained_ratio x its count, and its
+// noise is then its count, else what the final model leaves there.
+struct GroupMisfit {
+  std::array<bool, 4> left{};
+  std::array<double, 4> excess{};
+};
+
+// The share of the misfit an effect removes, weighed where its evidence
+// lies: each group's misfit in the proportion of the chi^2 the effect
+// removes there; and whether most of that evidence lies where structure is
+// left.
+struct Share {
+  double fraction = 0.0;
+  bool where_left = false;
+};
+
+Share share_where_evidence_lies(const Chosen& c, const GroupMisfit& gm) {
+  double pos = 0.0, in_left = 0.0;
+  for (std::size_t g = 0; g < 4; ++g) {
+    const double r = std::max(0.0, c.removed_groups[g]);
+    pos += r;
+    if (gm.left[g]) in_left += r;
+  }
+  Share s;
+  if (!(pos > 0.0)) return s;
+  double den = 0.0;
+  for (std::size_t g = 0; g < 4; ++g)
+    den += std::max(0.0, c.removed_groups[g]) / pos * gm.excess[g];
+  s.fraction = c.removed_chi2 / std::max(1.0, den);
+  s.where_left = in_left >= 0.5 * pos;
+  return s;
+}
 
 class Auditor {
  public:
@@ -186,6 +226,11 @@ class Auditor {
   // than kBalanceMinSegments).
   double forced_ratio(const State& s) const;
   double slow_noise_factor(const State& s) const;
+  // Residual counts and chi^2 of the observation groups: the free decays,
+  // the excitation segments' frequencies, their amplitude balance and their
+  // pattern-angle drift.
+  std::array<double, 4> group_counts() const;
+  std::array<double, 4> group_chi2(const std::vector<double>& res) const;
 
   // Steps of run(), in order.
   Params start_params() const;
@@ -210,6 +255,7 @@ class Auditor {
   State test_constancy(State full, std::vector<Chosen>& chosen, AuditResult& out);
   void test_thermal_vs_drift(const State& full, std::vector<Chosen>& chosen, AuditResult& out);
   double temp_time_correlation() const;
+  GroupMisfit group_misfit(const State& full, bool structure_left, double excess_free) const;
   void weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                       bool structure_left, AuditResult& out);
   void report_baseline(const State& baseline, const State& cur, bool any_chosen, AuditResult& out);
@@ -223,6 +269,7 @@ class Auditor {
   std::size_t n_blocks_fit_ = 0;
   double baseline_chi2_ = 0.0, baseline_n_ = 0.0;  // the baseline's chi^2 and residual count
   double baseline_free_chi2_ = 0.0;                // its chi^2 on the free decays alone
+  std::vector<double> baseline_res_;               // its residuals
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
   Params start_balance_{};   // the free-decay baseline the balance starts from
   bool confounded_ = false;  // a thermal effect and a drift in time cannot be told apart
@@ -286,6 +333,28 @@ double Auditor::forced_ratio(const State& s) const {
   for (std::size_t i = n0; i < s.res.size(); ++i)
     acc += s.res[i] * s.res[i];
   return acc / static_cast<double>(s.res.size() - n0);
+}
+
+std::array<double, 4> Auditor::group_counts() const {
+  std::array<double, 4> n{n_free_res(), static_cast<double>(d_.forced.size()), 0.0, 0.0};
+  for (const auto& f : d_.forced) {
+    n[2] += f.balance_sigma_per_s > 0.0 ? 1.0 : 0.0;
+    n[3] += f.angle_sigma_rad_s > 0.0 ? 1.0 : 0.0;
+  }
+  if (!eo_.use_forced) n[1] = n[2] = n[3] = 0.0;
+  return n;
+}
+
+std::array<double, 4> Auditor::group_chi2(const std::vector<double>& res) const {
+  const auto n = group_counts();
+  std::array<double, 4> chi{};
+  std::size_t i = 0;
+  for (std::size_t g = 0; g < 4; ++g) {
+    const std::size_t end = std::min(res.size(), i + static_cast<std::size_t>(n[g]));
+    for (; i < end; ++i)
+      chi[g] += res[i] * res[i];
+  }
+  return chi;
 }
 
 double Auditor::rms_v(const State& s) const {
@@ -720,6 +789,11 @@ void Auditor::forward_select(State& cur, std::vector<Chosen>& chosen, AuditResul
   while (in_model() < 4) {
     std::vector<Candidate> cands = score_candidates(cur, chosen, first_step, out);
     first_step = false;
+    if (std::getenv("HRG_AUDIT_DEBUG")) {
+      for (std::size_t k = 0; k < std::min<std::size_t>(4, cands.size()); ++k)
+        std::fprintf(stderr, "select step %zu: %s dbic %.1f value %.4g sigma %.3g\n", chosen.size(),
+                     effect_info(cands[k].e).id, cands[k].dbic, cands[k].value, cands[k].sigma);
+    }
     if (cands.empty() || cands[0].dbic < opt_.min_delta_bic) {
       for (const auto& c : cands) {
         if (c.dbic > 0.0) {
@@ -786,7 +860,6 @@ State Auditor::describe(const State& cat, AuditResult& out) {
   std::vector<const GenericTerm*> taken;
   const double excess0 = std::max(1.0, baseline_free_chi2_ - n_free_res());
   double heldout_cur = -1.0;
-  const double slow = slow_noise_factor(cat);
   for (int step = 0; step < opt_.max_description_terms; ++step) {
     const GenericTerm* best = nullptr;
     double best_dbic = -1e300;
@@ -799,6 +872,8 @@ State Auditor::describe(const State& cat, AuditResult& out) {
       const double dbic = delta_bic(cur, s, t.n_params);
       if (dbic > best_dbic) best_dbic = dbic, best = &t;
     }
+    if (std::getenv("HRG_AUDIT_DEBUG") && best != nullptr)
+      std::fprintf(stderr, "describe best %s: dbic %.1f\n", best->id, best_dbic);
     if (best == nullptr || best_dbic < opt_.min_description_bic) break;
     State next = fit_state(with_term(cur.mask, *best), cur.fit.p, cur.feedthrough);
     const double dbic = delta_bic(cur, next, best->n_params);
@@ -809,12 +884,25 @@ State Auditor::describe(const State& cat, AuditResult& out) {
     const double heldout_fall = heldout_cur * heldout_cur - heldout_next * heldout_next;
     if (!(heldout_fall > 0.25 * fitted_fall)) break;
     const double share = (free_chi2(cur) - free_chi2(next)) / excess0;
+    if (std::getenv("HRG_AUDIT_DEBUG"))
+      std::fprintf(stderr,
+                   "describe try %s: dbic %.1f heldout fall %.3g fitted fall %.3g share %.3f "
+                   "slow %.2f noise^2 %.3g\n",
+                   best->id, dbic, heldout_fall, fitted_fall, share, slow_noise_factor(next),
+                   d_.noise_v * d_.noise_v);
     if (share < opt_.min_description_share) break;
     // Noise slower than the AR model follows (variance at long lags above
     // the white level): its slowest octaves are offsets and drifts over a
-    // recording, so a term must then also stand above them.
+    // recording, so a term must then also stand above them. That variance is
+    // the one the term leaves: measured with the term's own structure still
+    // in the residual, it counts that structure as slow noise (an offset of
+    // 13x the noise on the x pickoff of the firmware's telemetry raised it
+    // from 1.0 to 1.27 and held its own description back).
+    const double slow = slow_noise_factor(next);
     if (slow > 1.2 && fitted_fall < opt_.min_description_fall * slow * d_.noise_v * d_.noise_v)
       break;
+    if (std::getenv("HRG_AUDIT_DEBUG"))
+      std::fprintf(stderr, "describe: %s dbic %.1f share %.3f\n", best->id, dbic, share);
     out.description.terms.push_back({best->id, "", dbic, share});
     taken.push_back(best);
     heldout_cur = heldout_next;
@@ -976,8 +1064,17 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
       const double unique_dbic = delta_bic(without, full, n_params_of(e));
       chosen[k].unique_dchi = delta_chi2(without, full);
       chosen[k].removed_chi2 = std::max(0.0, without.fit.chi2 - full.fit.chi2);
-      chosen[k].removed_free_chi2 = free_chi2(without) - free_chi2(full);
+      const auto chi_without = group_chi2(without.res), chi_full = group_chi2(full.res);
+      for (std::size_t g = 0; g < 4; ++g)
+        chosen[k].removed_groups[g] = chi_without[g] - chi_full[g];
       chosen[k].unique_checked = true;
+      if (std::getenv("HRG_AUDIT_DEBUG"))
+        std::fprintf(stderr,
+                     "drop-one %s: unique dbic %.1f removes free %.1f freq %.1f balance %.1f "
+                     "angle %.1f\n",
+                     effect_info(e).id, unique_dbic, chosen[k].removed_groups[0],
+                     chosen[k].removed_groups[1], chosen[k].removed_groups[2],
+                     chosen[k].removed_groups[3]);
       if (unique_dbic < worst_dbic)
         worst_dbic = unique_dbic, worst = k, worst_without = std::move(without);
     }
@@ -1005,31 +1102,48 @@ std::string acceptance_rule_text(const AuditOptions& o) {
   std::snprintf(rule, sizeof rule,
                 "a finding stands at least %.3g of its standard deviations from zero and removes "
                 "at least %.3g of the baseline's misfit beyond the noise (explains_fraction) "
-                "when structure is left (a description, residual variance above %.3g x the "
-                "noise, or the excitation segments' observations above %.3g x their noise; "
-                "structure left on those segments alone: of the free decays' misfit for an "
-                "effect with most of its evidence there), and always when it is seen only on "
-                "the excitation segments (gap_harmonics); the free decays' noise is what the "
-                "final model leaves there unless structure is left on them; drive "
-                "feedthrough, seen on the switching edges, is not claimed with structure left",
+                "when structure is left (a description or residual variance above %.3g x the "
+                "noise; structure left on the excitation segments alone: when most of its "
+                "evidence lies in a group of their observations, frequency, balance or angle "
+                "drift, above %.3g x its noise, of the misfit where its evidence lies), and "
+                "always, of the whole misfit, when it is seen only on the excitation segments "
+                "(gap_harmonics); the free decays' noise is what the final model leaves there "
+                "unless structure is left on them; drive feedthrough, seen on the switching "
+                "edges, is not claimed with structure left",
                 o.min_significance, o.min_explains_fraction, o.unexplained_ratio,
                 o.unexplained_ratio);
   return rule;
 }
 
+GroupMisfit Auditor::group_misfit(const State& full, bool structure_left,
+                                  double excess_free) const {
+  GroupMisfit gm;
+  const auto n = group_counts();
+  const auto base = group_chi2(baseline_res_), fin = group_chi2(full.res);
+  gm.left[0] = structure_left;
+  gm.excess[0] = excess_free;
+  for (std::size_t g = 1; g < 4; ++g) {
+    gm.left[g] =
+        n[g] >= static_cast<double>(kBalanceMinSegments) && fin[g] > opt_.unexplained_ratio * n[g];
+    gm.excess[g] = std::max(0.0, base[g] - (gm.left[g] ? n[g] : fin[g]));
+  }
+  return gm;
+}
+
 // A finding must carry its own weight: after drop_unneeded() it must stand
 // min_significance of its standard deviations away from zero and remove at
 // least min_explains_fraction of the baseline's misfit beyond the noise
-// (given everything else) when structure is left (a description, residual
-// variance above the noise, or the excitation segments' observations above
-// their noise after the final model: a pull no catalogue term holds) and,
-// for an effect seen only on the excitation segments, always. With structure
-// left on the excitation segments alone, an effect with most of its evidence
-// on the free decays is weighed against the free decays' misfit: a pull on
-// the segments it does not act on is no share of what it could explain (on
-// the averaged model's telemetry that pull is there in every recording, the
-// null's included, and it turned single effects at 2-3x threshold into
-// alternatives). Otherwise it is an alternative.
+// (given everything else) when structure is left (a description or residual
+// variance above the noise on the free decays) and, for an effect seen only
+// on the excitation segments, always. With structure left on the excitation
+// segments alone (a pull no catalogue term holds), the rule holds an effect
+// whose evidence lies mostly in an excitation group left above its noise,
+// weighed against the misfit where its evidence lies. On the averaged
+// model's telemetry the excitation segments' pattern-angle drift stays at
+// 15x its noise in every recording, the null's included: weighed against
+// the whole misfit, single effects at 2-3x threshold and the weaker effects
+// of pairs and triples that act on the free decays and the segments'
+// frequency were alternatives. Otherwise it is an alternative.
 void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<Chosen>& chosen,
                              bool structure_left, AuditResult& out) {
   // The baseline's misfit beyond the noise, on the free decays and on the
@@ -1043,8 +1157,16 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
   const double excess_forced =
       std::max(0.0, (baseline_chi2_ - baseline_free_chi2_) - (baseline_n_ - n_free_res()));
   const double excess0 = excess_free + excess_forced;
-  const bool forced_left = forced_ratio(full) > opt_.unexplained_ratio;
+  const GroupMisfit gm = group_misfit(full, structure_left, excess_free);
+  const bool forced_left = gm.left[1] || gm.left[2] || gm.left[3];
   out.acceptance_rule = acceptance_rule_text(opt_);
+  if (std::getenv("HRG_AUDIT_DEBUG")) {
+    const auto b = group_chi2(baseline_res_), f = group_chi2(full.res), n = group_counts();
+    std::fprintf(stderr,
+                 "groups baseline/final (count): free %.1f/%.1f (%.0f) freq %.1f/%.1f (%.0f) "
+                 "balance %.1f/%.1f (%.0f) angle %.1f/%.1f (%.0f)\n",
+                 b[0], f[0], n[0], b[1], f[1], n[1], b[2], f[2], n[2], b[3], f[3], n[3]);
+  }
   std::vector<Chosen> kept;
   for (auto& c : chosen) {
     const int pi = param_of(c.effect);
@@ -1065,26 +1187,31 @@ void Auditor::weigh_findings(const State& full, const FeedStat& ft, std::vector<
     } else {
       c.fraction = -1.0;  // the edge statistic is outside the free-decay misfit
     }
-    // With structure left on the excitation segments alone, an effect whose
-    // evidence is on the free decays is weighed against their misfit: the
-    // segments' pull is no share of what it could explain.
-    if (pi >= 0 && forced_left && !structure_left && c.unique_checked &&
-        c.removed_free_chi2 >= 0.5 * c.removed_chi2) {
-      c.fraction = std::max(0.0, c.removed_free_chi2) / excess_free;
+    // With structure left on the excitation segments alone, an effect is
+    // held to its share only where its evidence lies mostly in a group left
+    // above its noise, and weighed against the misfit where it lies.
+    bool held_to_share = structure_left;
+    if (pi >= 0 && !structure_left) {
+      held_to_share = forced_left;
+      if (c.unique_checked && !seen_only_on_excitation(c.effect)) {
+        const Share sh = share_where_evidence_lies(c, gm);
+        c.fraction = sh.fraction;
+        held_to_share = sh.where_left;
+      }
     }
     const bool small = pi >= 0 && c.fraction < opt_.min_explains_fraction;
     if (std::getenv("HRG_AUDIT_DEBUG")) {
       std::fprintf(stderr,
                    "weigh %s: value %.4g sigma %.3g dbic %.1f unique_dchi %.1f removed_chi2 %.1f "
                    "excess0 %.1f (baseline chi2 %.1f n %.0f, free chi2 %.1f n %.0f) fraction "
-                   "%.3f forced_ratio %.2f structure_left %d removed_free %.1f\n",
+                   "%.3f forced_ratio %.2f structure_left %d held_to_share %d\n",
                    effect_info(c.effect).id, value, sigma, c.dbic, c.unique_dchi, c.removed_chi2,
                    excess0, baseline_chi2_, baseline_n_, baseline_free_chi2_, n_free_res(),
-                   c.fraction, forced_ratio(full), structure_left ? 1 : 0, c.removed_free_chi2);
+                   c.fraction, forced_ratio(full), structure_left ? 1 : 0, held_to_share ? 1 : 0);
     }
     if (!(std::abs(value) >= opt_.min_significance * sigma)) {
       why = "not significantly away from zero";
-    } else if ((structure_left && pi < 0) || (small && (structure_left || forced_left))) {
+    } else if ((structure_left && pi < 0) || (small && held_to_share)) {
       why = "takes up only part of structure that stays unexplained; not claimed";
     } else if (small && seen_only_on_excitation(c.effect)) {
       why =
@@ -1184,6 +1311,7 @@ AuditResult Auditor::run(PlotData* plot) {
   baseline_chi2_ = baseline.fit.chi2;
   baseline_n_ = static_cast<double>(baseline.fit.n_res);
   baseline_free_chi2_ = free_chi2(baseline);
+  baseline_res_ = baseline.res;
   State full = describe(cur, out);
   full = drop_unneeded(std::move(full), chosen, out);
   full = test_constancy(std::move(full), chosen, out);

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: MIT
+// Three catalogue effects at once on the averaged model's telemetry, each at
+// 2-3x its detection threshold: every one is a finding within 20 %. That
+// design's excitation segments keep their pattern-angle drift at about 15x
+// its noise in every recording (the null's included), a pull no catalogue
+// term holds; an effect acting on the free decays and the segments'
+// frequency is weighed where its evidence lies, not against that drift
+// (tools/audit/README.md step 7). Slow: one audit of 360 s of telemetry.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "audit/audit.hpp"
+#include "../../tools/audit/src/campaign.hpp"
+
+#include "support/cpputest.hpp"
+
+namespace bench = hrg::audit::bench;
+using hrg::audit::AuditResult;
+using hrg::audit::Effect;
+
+namespace {
+
+// Design 16 of `hrg audit-bench --seed 2026` (seed 2026 * 100003 + 16): a
+// telemetry campaign of 360 s against a reference that follows the resonance.
+bench::Scenario telemetry() {
+  bench::Scenario s =
+      bench::random_scenario(bench::Design::telemetry, 360.0, 2026ULL * 100003ULL + 16);
+  s.pll_reference = true;
+  s.temp_cycles = true;
+  return s;
+}
+
+struct Concealed {
+  Effect effect;
+  double value;
+};
+
+void check_finding(const AuditResult& r, const Concealed& c, const std::string& text) {
+  const auto it = std::find_if(r.findings.begin(), r.findings.end(),
+                               [&](const auto& f) { return f.effect == c.effect; });
+  CHECK_TEXT(it != r.findings.end(), text.c_str());
+  CHECK_TEXT(std::abs(it->value - c.value) <= 0.2 * std::abs(c.value), text.c_str());
+  CHECK_TEXT(it->significance >= 5.0, text.c_str());
+}
+
+}  // namespace
+
+TEST_GROUP(AuditSeveralEffects){};
+
+TEST(AuditSeveralEffects, ATripleOnTelemetryIsFoundWhole) {
+  // GIVEN the benchmark's triple of that design (values at 2.0x-2.9x the
+  // thresholds its null twin gives): a thermal damping, a thermal frequency
+  // and an electrostatic spring
+  const Concealed triple[] = {{Effect::thermal_damping, 0.003284},
+                              {Effect::thermal_frequency, -0.0003257},
+                              {Effect::electrostatic_spring, 2.821e-08}};
+  bench::Scenario s = telemetry();
+  for (const auto& c : triple)
+    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
+  // WHEN it is audited
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "triple");
+  // THEN all three are findings within 20 % (before: the thermal damping,
+  // 2.919e-3 at 7.1 sigma, an alternative that removed 3.5 % of a misfit
+  // mostly the segments' angle drift)
+  STRCMP_EQUAL_TEXT("explained", r.verdict.c_str(), text.c_str());
+  CHECK_EQUAL_TEXT(3, static_cast<int>(r.findings.size()), text.c_str());
+  for (const auto& c : triple)
+    check_finding(r, c, text);
+}
