@@ -257,7 +257,8 @@ void Gyro::check_model() {
   }
   if (h.windows_checked != checks_seen_) {
     checks_seen_ = h.windows_checked;
-    if (h.window_misfit <= cfg_.max_window_misfit) {
+    // Two-sided: the check window's residual against the fit's own residual.
+    if (h.window_misfit <= cfg_.max_window_misfit && h.window_misfit >= cfg_.min_window_misfit) {
       ++checks_passed_;
     } else {
       ++status_.model_checks_failed;

@@ -41,6 +41,12 @@ struct GyroConfig {
   // EstimatorHealth::window_misfit, above this): the output is then the raw
   // angle, reported so.
   double max_window_misfit = 4.0;
+  // ... or far below it: a still free decay much quieter than the fit's own
+  // residual (sigma_hat) says the campaign's windows carried a signal the
+  // model does not have (a pickoff misalignment's 4 theta pattern in E while
+  // the table turns), which inflated sigma_hat and with it the tolerance of
+  // every check. When the model holds, the misfit is 1 +- ~0.1.
+  double min_window_misfit = 0.25;
   // Do no harm while the pump runs: the step of the corrected signal at
   // every switch-off (PumpEdgeCheck). A step above its tolerance makes the
   // compensation not valid.

@@ -119,8 +119,10 @@ bool judge(const RunConfig& job, RunResult& r) {
   if (r.model_checks_failed > 0) {
     r.failures.push_back(
         fmt("the drift compensation is not valid: %u check window(s) disagreed "
-            "with the model (last misfit %.1f); the output is the raw angle",
-            r.model_checks_failed, r.last_window_misfit));
+            "with the model (last misfit %.3g, agreement between %.3g and %.3g); "
+            "the output is the raw angle",
+            r.model_checks_failed, r.last_window_misfit, job.firmware.gyro.min_window_misfit,
+            job.firmware.gyro.max_window_misfit));
   }
   if (r.calibration.verdict == fw::app::CalibrationVerdict::withdrawn) {
     const fw::app::CalibrationStatus& c = r.calibration;
