@@ -689,7 +689,7 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
   for (std::size_t k = 0; k < n; ++k) {
     const auto& f = d_.forced[use[k]];
     const auto row = static_cast<Eigen::Index>(k);
-    const double t = f.angle_span_s;
+    const double t = f.t1_s - f.t0_s;
     h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.mean_rate_rad_s;
     y(row) = t * r[k];
     se2 += t * t * f.angle_se_rad_s * f.angle_se_rad_s / static_cast<double>(n);
@@ -701,7 +701,7 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
     std::fprintf(stderr, "angle: e %.3g rad, se2 %.3g\n", std::sqrt(e2), se2);
   for (std::size_t k = 0; k < n; ++k) {
     auto& f = d_.forced[use[k]];
-    const double t = f.angle_span_s;
+    const double t = f.t1_s - f.t0_s;
     f.angle_sigma_rad_s = std::sqrt(f.angle_se_rad_s * f.angle_se_rad_s + e2 / (t * t));
     if (std::getenv("HRG_AUDIT_DEBUG"))
       std::fprintf(stderr, "  %.2f-%.2f angle res %.3g sigma %.3g c4 %.2f s4 %.2f\n", f.t0_s,

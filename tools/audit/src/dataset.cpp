@@ -278,12 +278,10 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
   f.theta0_rad = r.theta[q0];
   f.theta1_rad = r.theta[q1];
-  f.angle_span_s = r.t[q1] - r.t[q0];
   f.se_rad_s = std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
   f.balance_se_per_s = f.se_rad_s;  // ln a_A and the phase see the same noise per row
   // theta from single rows: half the phase's noise per row (theta = arg / 2), k = 1.
-  f.angle_se_rad_s =
-      f.se_rad_s * std::sqrt(static_cast<double>(k)) / 2.0 * (te - ts) / f.angle_span_s;
+  f.angle_se_rad_s = f.se_rad_s * std::sqrt(static_cast<double>(k)) / 2.0;
   d.forced.push_back(f);
 }
 

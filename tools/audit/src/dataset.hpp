@@ -49,12 +49,9 @@ struct ForcedSegment {
   double dlna_per_s = 0.0;  // (ln a_A(end) - ln a_A(start)) / (t1 - t0), ends as for the phase
   double balance_se_per_s = 0.0;     // of dlna_per_s, from the white noise
   double balance_sigma_per_s = 0.0;  // weight of the amplitude balance (0: not used)
-  double angle_se_rad_s = 0.0;       // of (theta1 - theta0)/angle_span_s, from the white noise
-  // Time between the single rows theta0 and theta1 are read at (t1 - t0 is
-  // between the three-row means of the ends, two rows shorter).
-  double angle_span_s = 0.0;
-  double angle_sigma_rad_s = 0.0;  // weight of the pattern-angle drift (0: not used)
-  double mean_a2 = 0.0;            // mean a_A^2
+  double angle_se_rad_s = 0.0;       // of (theta1 - theta0)/(t1 - t0), from the white noise
+  double angle_sigma_rad_s = 0.0;    // weight of the pattern-angle drift (0: not used)
+  double mean_a2 = 0.0;              // mean a_A^2
   double mean_temp_c = 0.0;
   double mean_rate_rad_s = 0.0;
   // Change over the segment, per second and with the ends as for the phase,
