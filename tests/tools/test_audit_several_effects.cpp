@@ -13,6 +13,7 @@
 
 #include "audit/audit.hpp"
 #include "../../tools/audit/src/campaign.hpp"
+#include "audit_bench_design.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -24,13 +25,7 @@ namespace {
 
 // Design 16 of `hrg audit-bench --seed 2026` (seed 2026 * 100003 + 16): a
 // telemetry campaign of 360 s against a reference that follows the resonance.
-bench::Scenario telemetry() {
-  bench::Scenario s =
-      bench::random_scenario(bench::Design::telemetry, 360.0, 2026ULL * 100003ULL + 16);
-  s.pll_reference = true;
-  s.temp_cycles = true;
-  return s;
-}
+bench::Scenario telemetry() { return bench::test::pll_telemetry_design(2026, 16, 360.0); }
 
 struct Concealed {
   Effect effect;

@@ -11,6 +11,7 @@
 
 #include "audit/audit.hpp"
 #include "../../tools/audit/src/campaign.hpp"
+#include "audit_bench_design.hpp"
 
 #include "support/cpputest.hpp"
 
@@ -22,13 +23,7 @@ namespace {
 
 // Design 10 of `hrg audit-bench --seed 2026` (seed 2026 * 100003 + 10): a
 // telemetry campaign of 360 s against a reference that follows the resonance.
-bench::Scenario telemetry() {
-  bench::Scenario s =
-      bench::random_scenario(bench::Design::telemetry, 360.0, 2026ULL * 100003ULL + 10);
-  s.pll_reference = true;
-  s.temp_cycles = true;
-  return s;
-}
+bench::Scenario telemetry() { return bench::test::pll_telemetry_design(2026, 10, 360.0); }
 
 double threshold_of(const AuditResult& r, Effect e) {
   for (const auto& c : r.candidates) {
