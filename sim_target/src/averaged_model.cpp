@@ -34,6 +34,15 @@ void put_conjugate(M& a, int row, int col, cplx n) {
 
 }  // namespace
 
+namespace {
+// R and S of the envelopes, and theta_A = atan2(S, R) / 4.
+double r_of(double cx, double sx, double cy, double sy) {
+  return cx * cx + sx * sx - cy * cy - sy * sy;
+}
+double s_of(double cx, double sx, double cy, double sy) { return 2.0 * (cx * cy + sx * sy); }
+double theta_of(double s_v2, double r_v2) { return std::atan2(s_v2, r_v2) / 4.0; }
+}  // namespace
+
 WaveState wave_state(cplx x, cplx y) {
   WaveState w;
   const double cx = x.real();
@@ -41,10 +50,10 @@ WaveState wave_state(cplx x, cplx y) {
   const double cy = y.real();
   const double sy = -y.imag();
   w.energy_v2 = cx * cx + sx * sx + cy * cy + sy * sy;
-  w.r_v2 = cx * cx + sx * sx - cy * cy - sy * sy;
-  w.s_v2 = 2.0 * (cx * cy + sx * sy);
+  w.r_v2 = r_of(cx, sx, cy, sy);
+  w.s_v2 = s_of(cx, sx, cy, sy);
   w.quad_v2 = 2.0 * (cx * sy - cy * sx);
-  w.theta_rad = std::atan2(w.s_v2, w.r_v2) / 4.0;
+  w.theta_rad = theta_of(w.s_v2, w.r_v2);
   const double plus = std::sqrt(std::max(0.0, w.energy_v2 + w.quad_v2));
   const double minus = std::sqrt(std::max(0.0, w.energy_v2 - w.quad_v2));
   w.a_A_v = 0.5 * (plus + minus);
@@ -52,6 +61,14 @@ WaveState wave_state(cplx x, cplx y) {
   const cplx along = x * std::cos(2.0 * w.theta_rad) + y * std::sin(2.0 * w.theta_rad);
   w.phase_a_rad = std::arg(along);
   return w;
+}
+
+double wave_angle_rad(cplx x, cplx y) {
+  const double cx = x.real();
+  const double sx = -x.imag();
+  const double cy = y.real();
+  const double sy = -y.imag();
+  return theta_of(s_of(cx, sx, cy, sy), r_of(cx, sx, cy, sy));
 }
 
 void standing_wave(double a_A_v, double theta_rad, double a_B_v, double phase_rad, cplx& x_env,

@@ -103,6 +103,17 @@ uint64_t SimTarget::sample_time_ns(uint64_t index) const {
   return index / fs * 1'000'000'000ull + (index % fs) * 1'000'000'000ull / fs;
 }
 
+namespace {
+// std::remainder(d, pi/2) without the library call where it is d itself:
+// |d| < pi/4 (half the divisor, exact) rounds the quotient to 0, and the
+// remainder d - 0 is exact. A block turns the pattern by far less.
+double quarter_turn_remainder(double d_rad) {
+  constexpr double kQuarterTurn = kPi / 2;
+  if (std::fabs(d_rad) < 0.5 * kQuarterTurn) return d_rad;
+  return std::remainder(d_rad, kQuarterTurn);
+}
+}  // namespace
+
 TrueState SimTarget::true_state() const {
   TrueState s;
   s.t_s = time_s();
@@ -110,7 +121,7 @@ TrueState SimTarget::true_state() const {
   cplx y;
   resonator_.envelopes(x, y);
   const WaveState w = wave_state(x, y);
-  s.pattern_angle_rad = pattern_angle_rad_ + std::remainder(w.theta_rad - last_theta_rad_, kPi / 2);
+  s.pattern_angle_rad = pattern_angle_rad_ + quarter_turn_remainder(w.theta_rad - last_theta_rad_);
   s.input_angle_rad = input_angle_rad_;
   s.energy_v2 = w.energy_v2;
   s.a_A_v = w.a_A_v;
@@ -380,8 +391,8 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   cplx x;
   cplx y;
   resonator_.envelopes(x, y);
-  const double theta = wave_state(x, y).theta_rad;
-  pattern_angle_rad_ += std::remainder(theta - last_theta_rad_, kPi / 2);
+  const double theta = wave_angle_rad(x, y);
+  pattern_angle_rad_ += quarter_turn_remainder(theta - last_theta_rad_);
   last_theta_rad_ = theta;
   can_.tick(t1 - t0);
   counters_.adc_clipped += clipped;

@@ -83,6 +83,9 @@ struct RecordingRow {
 };
 
 WaveState wave_state(cplx x_env, cplx y_env);
+// wave_state()'s theta_rad alone (the same operations, so the same bits), for
+// the simulated board's once-per-block unwrap of the pattern angle.
+double wave_angle_rad(cplx x_env, cplx y_env);
 
 // Envelopes of a standing wave: Z = e^{i phase}(a_A [cos2th, sin2th] - i a_B [-sin2th, cos2th]),
 // so that Q = 2 a_A a_B.
