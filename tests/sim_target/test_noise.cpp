@@ -3,9 +3,11 @@
 // the normal distribution's moments, tail probabilities and histogram, and no
 // correlation from one draw to the next eight (the lanes of the generator). Bounds are 5 standard
 // errors of each statistic for N draws (the seed is fixed, so the test is deterministic).
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "sim_target/noise.hpp"
@@ -144,4 +146,63 @@ TEST(Gaussian, TheIntegerAbscissaIsTheFloatingPointOne) {
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     check(z ^ (z >> 31));
   }
+}
+
+TEST(Gaussian, TheWedgeSqueezeDecidesAsTheExpDoes) {
+  // The wedge test y < exp(-x^2/2) is decided without the exp where y is
+  // clear of the tangent (below) or the chord (above) of exp(-v), v =
+  // x^2 / 2. Over each layer's wedge rectangle (x uniform over [x[i+1],
+  // x[i]], y over [f(x[i]), f(x[i+1])], as the ziggurat's wedge draws are),
+  // and at y within a few ulps of the density: every decision is the exp
+  // comparison's, and the share decided is the area outside the band
+  // between the two bounds (integrated here), within 5 standard errors.
+  using G = hrg::sim::detail::Gaussian;
+  G g(314159);
+  const auto f = [](double v) { return std::exp(-v); };
+  constexpr int kPerLayer = 20'000;
+  double decided = 0.0;
+  double expected = 0.0;
+  double variance = 0.0;
+  for (std::size_t i = 1; i < 128; ++i) {
+    const double a = G::layer_edge(i + 1);
+    const double b = G::layer_edge(i);
+    const double v_a = 0.5 * a * a;
+    const double v_b = 0.5 * b * b;
+    const double f_a = f(v_a);
+    const double f_b = f(v_b);
+    // The band's share of the rectangle: chord minus tangent (at the
+    // middle of v), both clipped to [f_b, f_a], by the midpoint rule.
+    const double v_m = 0.5 * (v_a + v_b);
+    double band = 0.0;
+    constexpr int kSteps = 2000;
+    for (int k = 0; k < kSteps; ++k) {
+      const double x = a + (k + 0.5) / kSteps * (b - a);
+      const double v = 0.5 * x * x;
+      const double chord = f_a + (f_b - f_a) * (v - v_a) / (v_b - v_a);
+      const double tangent = std::max(f_b, f(v_m) * (1.0 - (v - v_m)));
+      band += std::max(0.0, chord - tangent) / kSteps;
+    }
+    const double p = 1.0 - band / (f_a - f_b);
+    expected += p * kPerLayer;
+    variance += p * (1.0 - p) * kPerLayer;
+    for (int k = 0; k < kPerLayer; ++k) {
+      const double x = a + g.uniform() * (b - a);
+      const double y = f_a + g.uniform() * (f_b - f_a);
+      const double minus_v = -0.5 * x * x;
+      const std::optional<bool> below = G::wedge_squeeze(i, y, minus_v);
+      if (below.has_value()) {
+        CHECK_EQUAL(y < std::exp(minus_v), *below);
+        decided += 1.0;
+      }
+      // At the density itself, a few ulps either side: decided right or not at all.
+      const double e = std::exp(minus_v);
+      for (const double y_near :
+           {e, std::nextafter(e, 0.0), std::nextafter(e, 2.0), e * (1 - 1e-14), e * (1 + 1e-14)}) {
+        const std::optional<bool> near = G::wedge_squeeze(i, y_near, minus_v);
+        if (near.has_value()) CHECK_EQUAL(y_near < e, *near);
+      }
+    }
+  }
+  CHECK(expected > 0.99 * 127 * kPerLayer);  // the band is thin: the exp is rarely needed
+  CHECK(std::fabs(decided - expected) < 5.0 * std::sqrt(variance));
 }
