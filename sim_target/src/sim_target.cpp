@@ -44,7 +44,6 @@ void SimTarget::configure(const SimConfig& c) {
   std::vector<hal::q31_t>().swap(dac_queue_);
   dac_head_ = 0;
   std::vector<hal::q31_t>(hal::kDacChannels * c.dac.latency_samples, 0).swap(dac_latency_);
-  std::vector<hal::q31_t>(dac_latency_.size(), 0).swap(latency_spare_);
   latency_pos_ = 0;
   dac_written_ = false;
   adc_stuck_ = {};
@@ -147,12 +146,25 @@ void SimTarget::fill_drives(std::size_t m) {
   constexpr std::size_t kCh = hal::kDacChannels;
   const std::size_t queued = std::min(dac_queue_.size() / kCh - dac_head_, m);
   if (queued < m && dac_written_) counters_.dac_underruns += m - queued;
-  if (queued > 0) std::copy_n(dac_queue_.data() + kCh * dac_head_, kCh * queued, words_.data());
-  std::fill_n(words_.begin() + static_cast<std::ptrdiff_t>(kCh * queued), kCh * (m - queued), 0);
-  if (!dac_latency_.empty()) delay_frames(m);
-  // Every code counts at the rails; a channel is gated off (0 V) while the
-  // excitation is off or it is dead.
-  counters_.dac_saturated += dac_q_.convert_block(words_.data(), drive_v_.data(), kCh * m);
+  const hal::q31_t* input = dac_queue_.data() + kCh * dac_head_;
+  const std::size_t latency = dac_latency_.size() / kCh;
+  if (m < latency) {  // the latency line frame by frame
+    if (queued > 0) std::copy_n(input, kCh * queued, words_.data());
+    std::fill_n(words_.begin() + static_cast<std::ptrdiff_t>(kCh * queued), kCh * (m - queued), 0);
+    delay_frames(m);
+    counters_.dac_saturated += dac_q_.convert_block(words_.data(), drive_v_.data(), kCh * m);
+  } else {
+    // Converted where the frames are, in output order: the latency line's
+    // frames (oldest first), then the first m - latency inputs; the last
+    // `latency` inputs become the line. Every output code counts at the rails.
+    counters_.dac_saturated += delayed_out(latency);
+    const std::size_t direct = std::min(queued, m - latency);
+    double* out = drive_v_.data() + kCh * latency;
+    counters_.dac_saturated += dac_q_.convert_block(input, out, kCh * direct);
+    std::fill(out + kCh * direct, drive_v_.data() + kCh * m, 0.0);  // 0 V: code 0, not a rail
+    if (latency > 0) delay_in(input, queued, m, latency);
+  }
+  // A channel is gated off (0 V) while the excitation is off or it is dead.
   std::array<bool, kCh> live{};
   for (std::size_t ch = 0; ch < kCh; ++ch)
     live[ch] = excitation_.value && !dac_dead_[ch];
@@ -166,29 +178,40 @@ void SimTarget::fill_drives(std::size_t m) {
   }
 }
 
+uint32_t SimTarget::delayed_out(std::size_t latency) {
+  if (latency == 0) return 0;
+  // The line's frames from latency_pos_ (the oldest) to its end, then from its start.
+  constexpr std::size_t kCh = hal::kDacChannels;
+  const std::size_t older = latency - latency_pos_;
+  const hal::q31_t* line = dac_latency_.data();
+  double* out = drive_v_.data();
+  return dac_q_.convert_block(line + kCh * latency_pos_, out, kCh * older) +
+         dac_q_.convert_block(line, out + kCh * older, kCh * latency_pos_);
+}
+
+void SimTarget::delay_in(const hal::q31_t* input, std::size_t queued, std::size_t m,
+                         std::size_t latency) {
+  // The last `latency` of the m input frames (queued ones, then zeros) become the line.
+  constexpr std::size_t kCh = hal::kDacChannels;
+  const std::size_t first = m - latency;
+  const std::size_t from_queue = queued > first ? queued - first : 0;
+  std::copy_n(input + kCh * first, kCh * from_queue, dac_latency_.begin());
+  std::fill(dac_latency_.begin() + static_cast<std::ptrdiff_t>(kCh * from_queue),
+            dac_latency_.end(), 0);
+  latency_pos_ = 0;
+}
+
 void SimTarget::delay_frames(std::size_t m) {
+  // Frame k leaves the ring at pos and frame k's input takes its place.
   constexpr std::size_t kCh = hal::kDacChannels;
   const std::size_t latency = dac_latency_.size() / kCh;
   hal::q31_t* in = words_.data();
-  if (m < latency) {  // frame k leaves the ring at pos and frame k's input takes its place
-    std::size_t pos = latency_pos_;
-    for (std::size_t k = 0; k < m; ++k) {
-      std::swap_ranges(in + kCh * k, in + kCh * (k + 1), dac_latency_.data() + kCh * pos);
-      pos = pos + 1 == latency ? 0 : pos + 1;
-    }
-    latency_pos_ = pos;
-    return;
+  std::size_t pos = latency_pos_;
+  for (std::size_t k = 0; k < m; ++k) {
+    std::swap_ranges(in + kCh * k, in + kCh * (k + 1), dac_latency_.data() + kCh * pos);
+    pos = pos + 1 == latency ? 0 : pos + 1;
   }
-  // The same as m swaps, as three copies: the last `latency` inputs become
-  // the ring, the others move up by `latency` frames, and the ring's frames
-  // (oldest first, from pos) come first.
-  const auto ring_pos = static_cast<std::ptrdiff_t>(kCh * latency_pos_);
-  std::copy_n(in + kCh * (m - latency), kCh * latency, latency_spare_.begin());
-  std::copy_backward(in, in + kCh * (m - latency), in + kCh * m);
-  const auto oldest = std::copy(dac_latency_.begin() + ring_pos, dac_latency_.end(), in);
-  std::copy(dac_latency_.begin(), dac_latency_.begin() + ring_pos, oldest);
-  dac_latency_.swap(latency_spare_);
-  latency_pos_ = 0;
+  latency_pos_ = pos;
 }
 
 namespace {

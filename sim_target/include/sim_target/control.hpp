@@ -179,8 +179,15 @@ class SimTarget {
   void fill_drives(std::size_t m);
   void fill_drives_loop(std::size_t m);
   void fill_drives_wide(std::size_t m);
-  // words_[0..3m) frame by frame through the DAC's latency line (ring).
+  // words_[0..3m) frame by frame through the DAC's latency line (ring),
+  // for m below the latency.
   void delay_frames(std::size_t m);
+  // For m >= the latency: the line's frames converted into drive_v_'s
+  // first frames (returns how many codes were at a rail), and the last
+  // `latency` of the m input frames (`queued` of them from input) put in
+  // the line.
+  uint32_t delayed_out(std::size_t latency);
+  void delay_in(const hal::q31_t* input, std::size_t queued, std::size_t m, std::size_t latency);
   uint64_t sample_time_ns(uint64_t index) const;
 
   SimConfig config_;
@@ -200,10 +207,9 @@ class SimTarget {
   uint64_t sample_index_ = 0;
   // Queued DAC frames [dac_head_, end) and the latency line (ring); plain
   // vectors so that configure() can release every allocation.
-  std::vector<hal::q31_t> dac_queue_;      // frames, flat
-  std::size_t dac_head_ = 0;               // in frames
-  std::vector<hal::q31_t> dac_latency_;    // latency_samples frames, flat
-  std::vector<hal::q31_t> latency_spare_;  // its size: the next ring
+  std::vector<hal::q31_t> dac_queue_;    // frames, flat
+  std::size_t dac_head_ = 0;             // in frames
+  std::vector<hal::q31_t> dac_latency_;  // latency_samples frames, flat
   std::size_t latency_pos_ = 0;
   bool dac_written_ = false;
   std::array<bool, 2> adc_stuck_{};
