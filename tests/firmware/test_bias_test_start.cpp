@@ -48,12 +48,7 @@ void check_no_control_drift(double q, double dmu, double split_hz) {
 }
 }  // namespace
 
-TEST_GROUP(BiasTestStart){void setup()
-                              override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(BiasTestStart);
 
 TEST(BiasTestStart, ASlowConvergingResonatorIsReportedNotMeasuredWithTheLengthItNeeds) {
   // GIVEN the relaxed resonator (Q 1e6, dmu 0.15, split 5e-3 Hz), whose
@@ -88,12 +83,7 @@ TEST(BiasTestStart, TheDefaultRunsParksAreMostlyMeasuredWithTheModelValid) {
   CHECK(hrg::sim_run::judge(j, r));
 }
 
-TEST_GROUP(ControlDriftGate){
-    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(ControlDriftGate);
 
 TEST(ControlDriftGate, SeedResonatorIdealElectrodeAddsLessThanTheModelsOwnUncertainty) {
   check_no_control_drift(5.0e6, 0.05, 5.0e-4);

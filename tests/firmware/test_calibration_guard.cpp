@@ -12,6 +12,7 @@ using hrg::fw::app::CalibrationVerdict;
 
 namespace {
 
+constexpr double kMinMisfit = 0.25;
 constexpr double kMaxMisfit = 4.0;
 
 EstimatorHealth checked(uint32_t windows, double misfit) {
@@ -26,7 +27,7 @@ EstimatorHealth checked(uint32_t windows, double misfit) {
 TEST_GROUP(CalibrationGuard){};
 
 TEST(CalibrationGuard, TheIdentityIsNotJudged) {
-  CalibrationGuard g(kMaxMisfit);
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
   g.applied(CalibrationSource::file, 0, true, 0.0, {}, false);
   CHECK(g.status().source == CalibrationSource::none);
   CHECK_FALSE(g.judge(checked(5, 100.0), true, 1.0));
@@ -34,7 +35,7 @@ TEST(CalibrationGuard, TheIdentityIsNotJudged) {
 }
 
 TEST(CalibrationGuard, CampaignWindowsAreNoVerdictTheFirstCheckAfterIs) {
-  CalibrationGuard g(kMaxMisfit);
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
   g.applied(CalibrationSource::file, 7, false, 0.0, {}, false);
   // Windows checked during the campaign (an early model) and the one that
   // ends it prove nothing, whatever their misfit.
@@ -53,7 +54,7 @@ TEST(CalibrationGuard, CampaignWindowsAreNoVerdictTheFirstCheckAfterIs) {
 }
 
 TEST(CalibrationGuard, ACheckWithinTheNoiseConfirms) {
-  CalibrationGuard g(kMaxMisfit);
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
   g.applied(CalibrationSource::can, 7, false, 0.0, checked(2, 1.0), true);
   CHECK_FALSE(g.judge(checked(2, 1.0), true, 1.0));  // no new check yet
   CHECK_FALSE(g.judge(checked(3, 3.9), true, 2.0));
@@ -61,16 +62,38 @@ TEST(CalibrationGuard, ACheckWithinTheNoiseConfirms) {
   CHECK(g.status().source == CalibrationSource::can);
 }
 
+TEST(CalibrationGuard, AWindowFarQuieterThanTheModelsResidualNeitherConfirmsNorWithdraws) {
+  // A check misfit of 0.02 means the model's residual sigma is 50x what the
+  // window shows: it absorbed structure as noise, so the window cannot tell
+  // a right calibration from a wrong one. The calibration stays on trial;
+  // the next window in the band judges it.
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
+  g.applied(CalibrationSource::file, 7, false, 0.0, checked(2, 1.0), true);
+  CHECK_FALSE(g.judge(checked(3, 0.02), true, 2.0));
+  CHECK(g.status().verdict == CalibrationVerdict::on_trial);
+  DOUBLES_EQUAL(0.02, g.status().misfit_after, 0.0);
+  CHECK_EQUAL(0u, g.status().withdrawals);
+  // At the band's edge the window has its power back.
+  CHECK_FALSE(g.judge(checked(4, kMinMisfit), true, 3.0));
+  CHECK(g.status().verdict == CalibrationVerdict::confirmed);
+  // The same quiet window after a misfit-30 check is no "better than
+  // before" either: still on trial.
+  CalibrationGuard online(kMinMisfit, kMaxMisfit);
+  online.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
+  CHECK_FALSE(online.judge(checked(9, 0.1), true, 220.0));
+  CHECK(online.status().verdict == CalibrationVerdict::on_trial);
+}
+
 TEST(CalibrationGuard, AboveTheNoiseButBetterThanBeforeConfirms) {
   // Applied mid-run (online), after a check that already disagreed (misfit
   // 30): a check at 10 is not consistent with the noise but is better than
   // before: confirmed; at 31 it would have been withdrawn.
-  CalibrationGuard g(kMaxMisfit);
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
   g.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
   DOUBLES_EQUAL(30.0, g.status().misfit_before, 0.0);
   CHECK_FALSE(g.judge(checked(9, 10.0), true, 220.0));
   CHECK(g.status().verdict == CalibrationVerdict::confirmed);
-  CalibrationGuard worse(kMaxMisfit);
+  CalibrationGuard worse(kMinMisfit, kMaxMisfit);
   worse.applied(CalibrationSource::online, 7, false, 200.0, checked(8, 30.0), true);
   CHECK_TRUE(worse.judge(checked(9, 31.0), true, 220.0));
 }
@@ -79,7 +102,7 @@ TEST(CalibrationGuard, AboveTheNoiseButBetterThanBeforeConfirms) {
 // where no free-decay window looks: the switch-off step check judges it too.
 TEST(CalibrationGuard, AFeedthroughCalibrationIsConfirmedOnlyOnceTheSwitchOffsShowNoStep) {
   using hrg::fw::PumpEdgeVerdict;
-  CalibrationGuard g(kMaxMisfit);
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
   g.applied(CalibrationSource::file, 7, false, true, 0.0, {}, false);
   CHECK_TRUE(g.status().feedthrough);
   // The check window after the campaign agrees, the edges are not decided yet.
@@ -101,13 +124,13 @@ TEST(CalibrationGuard, AFeedthroughCalibrationIsConfirmedOnlyOnceTheSwitchOffsSh
 TEST(CalibrationGuard, AStepWithdrawsAFeedthroughCalibrationAtOnceButNotAPickoffOne) {
   using hrg::fw::PumpEdgeVerdict;
   // GIVEN a feedthrough calibration, the campaign still running
-  CalibrationGuard ft(kMaxMisfit);
+  CalibrationGuard ft(kMinMisfit, kMaxMisfit);
   ft.applied(CalibrationSource::file, 7, false, true, 0.0, {}, false);
   // THEN a step at the first switch-off withdraws it (no model needed)
   CHECK_TRUE(ft.judge(checked(0, 0.0), false, 3.0, PumpEdgeVerdict::step));
   CHECK(ft.status().verdict == CalibrationVerdict::withdrawn);
   // GIVEN a calibration of the pickoff map only: a step is not its doing
-  CalibrationGuard pickoff(kMaxMisfit);
+  CalibrationGuard pickoff(kMinMisfit, kMaxMisfit);
   pickoff.applied(CalibrationSource::file, 7, false, false, 0.0, {}, false);
   CHECK_FALSE(pickoff.judge(checked(0, 0.0), false, 3.0, PumpEdgeVerdict::step));
   CHECK(pickoff.status().verdict == CalibrationVerdict::on_trial);

@@ -18,14 +18,7 @@
 
 #include "support/cpputest.hpp"
 
-TEST_GROUP(CalibrationLoop){
-    // The simulated target is a process-wide singleton whose buffers outlive
-    // the test: its allocations are not leaks of this test.
-    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(CalibrationLoop);
 
 namespace {
 

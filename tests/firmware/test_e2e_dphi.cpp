@@ -103,12 +103,7 @@ void check_adds_nothing(const Resonator& res) {
 
 // The simulated target is a process-wide singleton whose buffers outlive the
 // test: its allocations are not leaks of this test.
-TEST_GROUP(ChartDPhi){void setup()
-                          override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(ChartDPhi);
 
 TEST(ChartDPhi, NavigationGradeIdealElectrodeAddsLessThanTheModelsBiasUncertainty) {
   check_adds_nothing({2.0e7, 0.01, 1.0e-4, 0.0, 0.0});

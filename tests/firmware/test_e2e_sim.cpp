@@ -247,12 +247,7 @@ RunResult run_with_fault(hrg::sim_run::FaultEvent::Kind kind) {
 }
 }  // namespace
 
-TEST_GROUP(InjectedFaults){void setup()
-                               override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(InjectedFaults);
 
 TEST(InjectedFaults, AStuckAdcChannelIsAFaultAndTheGyroRecoversAfterTheHoldTime) {
   const RunResult r = run_with_fault(hrg::sim_run::FaultEvent::Kind::adc_stuck);
@@ -321,12 +316,7 @@ RunResult run_control(bool compensate, bool gap) {
 }
 }  // namespace
 
-TEST_GROUP(ControlLoopDrift){
-    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(ControlLoopDrift);
 
 TEST(ControlLoopDrift, WithAnIdealPumpAddingDPhiDoesNotMakeTheBiasWorse) {
   // GIVEN the default resonator and an ideal ring electrode: the control
@@ -364,12 +354,7 @@ TEST(ControlLoopDrift, TheGapHarmonicsOfThePumpAreCompensated) {
   CHECK(on.fit_comp.amplitude() < 0.8 * off.fit_comp.amplitude());
 }
 
-TEST_GROUP(Lockstep){void setup()
-                         override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(Lockstep);
 
 TEST(Lockstep, RunsAreDeterministic) {
   // Same scenario, same seed: the same telemetry to the last bit, whatever

@@ -41,12 +41,7 @@ double crossing_s(const std::vector<ConvergencePoint>& c, double target_dph) {
 }
 }  // namespace
 
-TEST_GROUP(RunLength){void setup()
-                          override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(RunLength);
 
 TEST(RunLength, InformationGrowingAtAConstantRateIsExtrapolatedExactly) {
   // GIVEN sigma(t) = s0 / sqrt((t - t0) / 1 s): information (t - t0) / s0^2,
@@ -102,12 +97,7 @@ TEST(RunLength, TheRelaxedResonatorsUncertaintyReachesTheGoalWhenItsConvergenceP
   DOUBLES_EQUAL(reached_s, r.t_bias_goal_s, 0.25 * reached_s);
 }
 
-TEST_GROUP(LongRunPlan){void setup()
-                            override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(LongRunPlan);
 
 TEST(LongRunPlan, OperationWindowsLoseATenthOfTheAmplitudeAtMost) {
   // The long-run plan: 30 s operation windows, checks in the campaign's 5 s.

@@ -52,14 +52,7 @@ double threshold_of(const hrg::audit::AuditResult& r, hrg::audit::Effect e) {
 
 }  // namespace
 
-TEST_GROUP(AuditFirmwareCampaign){
-    // The simulated target is a process-wide singleton whose buffers outlive
-    // the test: its allocations are not leaks of this test.
-    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(AuditFirmwareCampaign);
 
 TEST(AuditFirmwareCampaign, NullIsConsistentAndConcealedEffectsAreFound) {
   using hrg::audit::Effect;

@@ -222,12 +222,7 @@ TEST(AuditBeyondCatalogue, BenchmarkTemperatureDoesNotFollowTime) {
 
 // The firmware's telemetry runs the firmware and sim_target, whose
 // function-local statics outlive one test: the leak check is off here.
-TEST_GROUP(AuditBeyondCatalogueFirmware){
-    void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(AuditBeyondCatalogueFirmware);
 
 TEST(AuditBeyondCatalogueFirmware, PickoffOffsetIsDescribedNeverNamed) {
   // GIVEN design 5 of `hrg audit-bench --seed 2026` (the firmware's own

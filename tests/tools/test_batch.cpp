@@ -21,11 +21,7 @@ double slow_sum(std::size_t i) {
 }
 }  // namespace
 
-TEST_GROUP(Batch){void setup() override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(Batch);
 
 TEST(Batch, ResultsAreByIndexAndIdenticalForAnyThreadCount) {
   const auto one = hrg::batch::run_indexed(57, 1, slow_sum);

@@ -74,14 +74,7 @@ fw::Calibration file_calibration() {
 
 }  // namespace
 
-TEST_GROUP(CanCalibrate){// The simulated target is a process-wide singleton whose buffers outlive
-                         // the test: its allocations are not leaks of this test.
-                         void setup()
-                             override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(CanCalibrate);
 
 TEST(CanCalibrate, AFileWrittenInTheServiceModeIsAppliedWithItsCrc) {
   Bench b;

@@ -35,12 +35,7 @@ ProcedureOptions effects_options() {
 
 // The simulated target is one static object that keeps the last job's
 // profiles; its allocations are not a test's leak.
-TEST_GROUP(Procedures){void setup()
-                           override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(Procedures);
 
 // An ideal whole-angle readout has K = 1: over whole 4 theta cycles neither the
 // drift nor the readout's 4 theta error changes the mean rate, and the pattern

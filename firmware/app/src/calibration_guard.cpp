@@ -72,6 +72,7 @@ bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s
     const double m = h.window_misfit;
     status_.misfit_after = m;
     status_.judged_s = t_s;
+    if (m < min_misfit_) return false;  // no power to judge: stays on trial
     const bool noise_like = m <= max_misfit_;
     const bool not_worse = status_.misfit_before > 0.0 && m <= status_.misfit_before;
     if (!(noise_like || not_worse)) return withdraw(t_s);

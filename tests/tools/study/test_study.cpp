@@ -165,12 +165,7 @@ TEST(StudyGrid, ADegenerateParkSetGivesNoAdbAndCarriesItsReason) {
   STRCMP_CONTAINS("\"comp_adb_dph\": null", line.c_str());
 }
 
-TEST_GROUP(StudySmallGrid){void setup()
-                               override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-}
-;
+TEST_GROUP_WITHOUT_LEAK_CHECK(StudySmallGrid);
 
 TEST(StudySmallGrid, EveryPointMeetsTwiceTheBoundOrCarriesItsReason) {
   for (const PointResult& p : small_grid_points()) {

@@ -6,7 +6,10 @@
 // check has judged it. The first check window after it (the campaign's own
 // windows prove nothing) must be consistent with the noise (misfit at most
 // the gyro's max_window_misfit) or, when a check was made before it was
-// applied, not worse than that one. A calibration with a feedthrough part is
+// applied, not worse than that one. A window far quieter than the model's
+// own residual (misfit below min_window_misfit: the model took structure
+// for noise, and the gyro withdraws its drift model) has no power to judge:
+// the calibration stays on trial until a window that has. A calibration with a feedthrough part is
 // also judged by the switch-off steps of the corrected signal
 // (PumpEdgeCheck, which free-decay windows cannot see): confirmed only once
 // they are consistent, withdrawn (on trial or confirmed) as soon as they
@@ -65,7 +68,8 @@ struct CalibrationStatus {
 
 class CalibrationGuard {
  public:
-  explicit CalibrationGuard(double max_misfit) : max_misfit_(max_misfit) {}
+  CalibrationGuard(double min_misfit, double max_misfit)
+      : min_misfit_(min_misfit), max_misfit_(max_misfit) {}
 
   // A calibration is now in force (`identity`: nothing to judge). `h` is the
   // estimator's health at that instant, `checking`: its check windows count
@@ -95,6 +99,7 @@ class CalibrationGuard {
   const CalibrationStatus& status() const { return status_; }
 
  private:
+  double min_misfit_;
   double max_misfit_;
   CalibrationStatus status_{};
   bool withdraw(double t_s);

@@ -32,7 +32,7 @@ class Firmware {
         chain_(cfg.chain),
         estimator_(cfg.estimator),
         gyro_(board, chain_, estimator_, timer, pacing, cfg.gyro),
-        guard_(cfg.gyro.max_window_misfit) {
+        guard_(cfg.gyro.min_window_misfit, cfg.gyro.max_window_misfit) {
     calibration_ok_ = apply_calibration(cfg.calibration, CalibrationSource::file);
     // A calibration written over CAN takes the same path.
     gyro_.set_calibration_apply(&Firmware::apply_from_can, this, cfg_.calibration);
