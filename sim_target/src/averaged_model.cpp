@@ -32,9 +32,6 @@ void put_conjugate(M& a, int row, int col, cplx n) {
   a(row + 1, col + 1) -= n.real();
 }
 
-}  // namespace
-
-namespace {
 // R and S of the envelopes, and theta_A = atan2(S, R) / 4.
 double r_of(double cx, double sx, double cy, double sy) {
   return cx * cx + sx * sx - cy * cy - sy * sy;

@@ -9,12 +9,12 @@
 // applied, not worse than that one. A window far quieter than the model's
 // own residual (misfit below min_window_misfit: the model took structure
 // for noise, and the gyro withdraws its drift model) has no power to judge:
-// the calibration stays on trial until a window that has. A calibration with a feedthrough part is
-// also judged by the switch-off steps of the corrected signal
-// (PumpEdgeCheck, which free-decay windows cannot see): confirmed only once
-// they are consistent, withdrawn (on trial or confirmed) as soon as they
-// show a step. Otherwise it is withdrawn (the chain goes back to no
-// correction) and the firmware says so.
+// the calibration stays on trial until a window that has. A calibration
+// with a feedthrough part is also judged by the switch-off steps of the
+// corrected signal (PumpEdgeCheck, which free-decay windows cannot see):
+// confirmed only once they are consistent, withdrawn (on trial or
+// confirmed) as soon as they show a step. Otherwise it is withdrawn (the
+// chain goes back to no correction) and the firmware says so.
 
 #include <cstdint>
 
