@@ -36,6 +36,8 @@ void PumpEdgeCheck::reset() {
   in_edge_ = false;
   weight_ = 0.0;
   weighted_r_ = {};
+  weighted_rr_ = {};
+  since_set_ = false;
 }
 
 void PumpEdgeCheck::LineSums::add(double t_row, const std::array<double, 4>& q) {
@@ -147,10 +149,26 @@ void PumpEdgeCheck::finish_edge() {
   residual(2, r[2], r[3]);
   const double w = 1.0 / var_r;
   weight_ += w;
-  for (std::size_t c = 0; c < 4; ++c)
+  for (std::size_t c = 0; c < 4; ++c) {
     weighted_r_[c] += w * r[c];
+    weighted_rr_[c] += w * r[c] * r[c];
+  }
   ++status_.edges;
   decide();
+}
+
+double PumpEdgeCheck::scatter() const {
+  if (status_.edges < 2) return 0.0;
+  // sum_i w_i (r_i - r_mean)^2 = sum w r^2 - W r_mean^2, per part; over the
+  // 4 (edges - 1) degrees of freedom it is the variance of unit weight, and
+  // times 1/W that of the mean.
+  double chi2 = 0.0;
+  for (std::size_t c = 0; c < 4; ++c) {
+    const double mean = weighted_r_[c] / weight_;
+    chi2 += std::max(0.0, weighted_rr_[c] - weight_ * mean * mean);
+  }
+  const double dof = 4.0 * static_cast<double>(status_.edges - 1);
+  return std::sqrt(chi2 / dof / weight_);
 }
 
 void PumpEdgeCheck::decide() {
@@ -160,6 +178,7 @@ void PumpEdgeCheck::decide() {
   s.y_re = weighted_r_[2] / weight_;
   s.y_im = weighted_r_[3] / weight_;
   s.sigma_v_per_v = 1.0 / std::sqrt(weight_);
+  s.scatter_v_per_v = scatter();
   const double v0 = std::sqrt(pump_re_v_ * pump_re_v_ + pump_im_v_ * pump_im_v_);
   s.step_v = std::max(std::hypot(s.x_re, s.x_im), std::hypot(s.y_re, s.y_im)) * v0;
   s.step_sigma_v = s.sigma_v_per_v * v0;
@@ -176,6 +195,11 @@ void PumpEdgeCheck::decide() {
 
 void PumpEdgeCheck::add_row(const ChainRecord& r, bool pump_on, bool steady) {
   const uint32_t centre = centre_phase(r.nco_phase);
+  if (!since_set_) {
+    since_s_ = r.t_s;
+    since_set_ = true;
+  }
+  status_.in_force_s = r.t_s - since_s_;
   if (pump_on && !steady) {
     in_edge_ = false;
     was_on_ = false;

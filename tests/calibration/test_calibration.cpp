@@ -114,3 +114,38 @@ TEST(Calibration, PickoffPartInQ30MatchesTheDoubleInverseToHalfAnLsb) {
   corner.pickoff_y_misalignment_rad = kCalibrationFields[2].max;
   CHECK_TRUE(pickoff_correction_q30(corner, q));
 }
+
+TEST(Calibration, AResidualOnTheCorrectedQuadraturesIsReferredBackToTheRawPickoffs) {
+  // GIVEN a feedthrough k at the raw pickoffs (X_ft = k_x P), P = 1 V at 0.3
+  // rad, through the map's inverse as the chain applies it
+  const Calibration c = measured_gyro();
+  hrg::dsp::PickoffCorrection<double> inv;
+  CHECK_TRUE(pickoff_correction(c, inv));
+  const hrg::dsp::FeedthroughCoefficients<double> raw{3e-4, -2e-4, 7e-4, 4e-4};
+  const double p_re = std::cos(0.3), p_im = std::sin(0.3);
+  // X = k P appears as cx = Re(kP), sx = -Im(kP).
+  hrg::dsp::Quadratures<double> q{
+      raw.x_re * p_re - raw.x_im * p_im, -(raw.x_re * p_im + raw.x_im * p_re),
+      raw.y_re * p_re - raw.y_im * p_im, -(raw.y_re * p_im + raw.y_im * p_re)};
+  hrg::dsp::correct_pickoffs(inv, q);
+  // The residual the switch-off check reads on them: r = X / P per channel.
+  const auto per_volt = [&](double cx, double sx, double& re, double& im) {
+    const double x_re = cx, x_im = -sx;
+    re = x_re * p_re + x_im * p_im;
+    im = x_im * p_re - x_re * p_im;
+  };
+  hrg::dsp::FeedthroughCoefficients<double> corrected;
+  per_volt(q.cx, q.sx, corrected.x_re, corrected.x_im);
+  per_volt(q.cy, q.sy, corrected.y_re, corrected.y_im);
+  // (the y channel moved: 1 % gain, 1 deg phase, 1 deg of 2b of x in it)
+  CHECK(std::fabs(corrected.y_re - raw.y_re) > 5e-6);
+  // THEN referred back it is k again, to rounding
+  const auto back = residual_at_raw_pickoffs(c, corrected);
+  DOUBLES_EQUAL(raw.x_re, back.x_re, 1e-15);
+  DOUBLES_EQUAL(raw.x_im, back.x_im, 1e-15);
+  DOUBLES_EQUAL(raw.y_re, back.y_re, 1e-15);
+  DOUBLES_EQUAL(raw.y_im, back.y_im, 1e-15);
+  // AND with no pickoff map it is the residual itself
+  const auto same = residual_at_raw_pickoffs(kIdentityCalibration, raw);
+  DOUBLES_EQUAL(raw.y_im, same.y_im, 0.0);
+}

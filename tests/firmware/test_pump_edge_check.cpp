@@ -57,6 +57,9 @@ struct EdgeFeed {
   uint32_t nco_base = 0;
   // The pump's amplitude swinging row to row by this fraction (the AGC's chatter).
   double pump_swing = 0.0;
+  // Row time: advances by row_s per row over every run.
+  double t_s = 0.0;
+  double row_s = 0.01;
 
   void run(PumpEdgeCheck& c, uint32_t on_rows, uint32_t off_rows) {
     const double t_e = cfg.edge_offset_rows;
@@ -97,6 +100,8 @@ struct EdgeFeed {
       row.pump_seen_v = on ? v0 : 0.0;
       row.pump_phase_rad = kPumpPhaseRad;
       row.wave.a_A_v = kAmplitudeV;
+      row.t_s = t_s;
+      t_s += row_s;
       c.add_row(row, on);
     }
   }
@@ -258,4 +263,41 @@ TEST(PumpEdgeCheck, APumpThatSwingsRowToRowIsWeightedAsTheLineWeightsItsRows) {
   DOUBLES_EQUAL(feed.r_x.imag(), c.status().x_im, 4.0 * sigma);
   DOUBLES_EQUAL(0.0, c.status().y_re, 4.0 * sigma);
   CHECK(c.status().verdict == PumpEdgeVerdict::step);
+}
+
+TEST(PumpEdgeCheck, TheEdgesScatterAsTheirNoiseSaysUnlessTheResidualMovesBetweenThem) {
+  // GIVEN 16 edges of noise alone: the mean's sigma from the edges' scatter
+  // (60 degrees of freedom: +-9 % of sd) is the stated sigma
+  EdgeFeed feed;
+  PumpEdgeCheck c(feed.cfg);
+  CHECK_EQUAL(0.0, c.status().scatter_v_per_v);
+  for (int i = 0; i < 16; ++i)
+    feed.run(c, 200, 100);
+  LONGS_EQUAL(16, c.status().edges);
+  DOUBLES_EQUAL(c.status().sigma_v_per_v, c.status().scatter_v_per_v,
+                0.3 * c.status().sigma_v_per_v);
+  // GIVEN x_re alternating between +-10 sigma of one edge: the pooled
+  // chi^2 over 60 degrees of freedom is ~16 x 100 + 60, so the scatter is
+  // sqrt(1660 / 60) = 5.3x the mean's sigma
+  PumpEdgeCheck moving(feed.cfg);
+  const double one = sigma_r_one_edge(feed.cfg);
+  for (int i = 0; i < 16; ++i) {
+    feed.r_x = {(i % 2 ? 10.0 : -10.0) * one, 0.0};
+    feed.run(moving, 200, 100);
+  }
+  DOUBLES_EQUAL(5.3, moving.status().scatter_v_per_v / moving.status().sigma_v_per_v, 0.8);
+}
+
+TEST(PumpEdgeCheck, ItSaysHowLongTheCorrectionItReadThroughHasBeenInForce) {
+  EdgeFeed feed;
+  PumpEdgeCheck c(feed.cfg);
+  // GIVEN 300 rows of 10 ms from t = 0
+  feed.run(c, 200, 100);
+  DOUBLES_EQUAL(299 * feed.row_s, c.status().in_force_s, 1e-9);
+  // WHEN the correction changes (reset) and 300 more rows come
+  c.reset();
+  DOUBLES_EQUAL(0.0, c.status().in_force_s, 0.0);
+  feed.run(c, 200, 100);
+  // THEN from the first row after the change
+  DOUBLES_EQUAL(299 * feed.row_s, c.status().in_force_s, 1e-9);
 }

@@ -62,6 +62,20 @@ dsp::FeedthroughCoefficients<double> feedthrough_coefficients(const Calibration&
           c.feedthrough_y_im_v_per_v};
 }
 
+dsp::FeedthroughCoefficients<double> residual_at_raw_pickoffs(
+    const Calibration& c, const dsp::FeedthroughCoefficients<double>& corrected) {
+  const double c2b = std::cos(2.0 * c.pickoff_y_misalignment_rad);
+  const double s2b = std::sin(2.0 * c.pickoff_y_misalignment_rad);
+  const double a_re = c2b * corrected.y_re + s2b * corrected.x_re;
+  const double a_im = c2b * corrected.y_im + s2b * corrected.x_im;
+  // Times (1 + g) e^{-i phi}.
+  const double cp = std::cos(c.pickoff_y_phase_rad);
+  const double sp = std::sin(c.pickoff_y_phase_rad);
+  const double gain = 1.0 + c.pickoff_y_gain;
+  return {corrected.x_re, corrected.x_im, gain * (a_re * cp + a_im * sp),
+          gain * (a_im * cp - a_re * sp)};
+}
+
 double frequency_offset_hz(const Calibration& c, double f_ref_hz, double temp_c, double a_A_v,
                            double pump_amplitude_v, bool pump_on) {
   double df = f_ref_hz * 1e-6 * c.thermal_frequency_ppm_per_c * (temp_c - c.temperature_ref_c);

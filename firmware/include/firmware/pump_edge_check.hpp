@@ -68,6 +68,14 @@ struct PumpEdgeStatus {
   double y_re = 0.0;
   double y_im = 0.0;
   double sigma_v_per_v = 0.0;
+  // The same sigma as the edges' own scatter gives it (the weighted spread of
+  // the edges' r about their mean, pooled over the 4 parts, over edges - 1;
+  // 0 below 2 edges): far above sigma_v_per_v, the edges disagree more than
+  // their noise says.
+  double scatter_v_per_v = 0.0;
+  // How long the correction the edges were read through has been in force:
+  // from the first row after the last reset to the last row (s).
+  double in_force_s = 0.0;
   // At the last edge's pump and amplitude: the step, its sigma, the tolerance (V).
   double step_v = 0.0;
   double step_sigma_v = 0.0;
@@ -110,6 +118,8 @@ class PumpEdgeCheck {
   void begin_edge();
   void finish_edge();
   void decide();
+  // The mean's sigma from the edges' scatter (PumpEdgeStatus::scatter_v_per_v).
+  double scatter() const;
 
   PumpEdgeCheckConfig cfg_;
   PumpEdgeStatus status_{};
@@ -135,9 +145,13 @@ class PumpEdgeCheck {
   double pump_re_v_ = 0.0;
   double pump_im_v_ = 0.0;
   double amplitude_v_ = 0.0;
-  // Inverse-variance sums of r over the edges.
+  // Inverse-variance sums of r and r^2 over the edges.
   double weight_ = 0.0;
   std::array<double, 4> weighted_r_{};
+  std::array<double, 4> weighted_rr_{};
+  // Time of the first row since the last reset.
+  double since_s_ = 0.0;
+  bool since_set_ = false;
 };
 
 }  // namespace hrg::fw

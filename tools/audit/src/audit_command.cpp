@@ -16,6 +16,7 @@
 
 #include "audit/audit.hpp"
 #include "audit/calibration_writer.hpp"
+#include "audit/firmware_estimates.hpp"
 #include "audit/plots.hpp"
 #include "recording/recording.hpp"
 
@@ -34,6 +35,11 @@ void usage(std::FILE* f) {
                "--calibration writes the accepted findings as the firmware's calibration file\n"
                "(with their 1-sigma uncertainties); --pump-phase-deg is the pump's phase\n"
                "against the wave in the firmware that recorded (default 45).\n");
+  std::fputs(
+      "The firmware's own estimates in the header (pump_edge_*, damping_check_*) are\n"
+      "combined with the audit's where it found the same effect; a malformed key is\n"
+      "refused.\n",
+      f);
 }
 
 }  // namespace
@@ -73,6 +79,9 @@ int audit_main(std::span<char* const> args) {
   try {
     const auto t0 = std::chrono::steady_clock::now();
     const recording::Recording rec = recording::read_recording(path);
+    // The firmware's own estimates in the header: refused before the audit
+    // runs when a key is malformed.
+    if (!calibration_out.empty()) cal_opt.firmware = firmware_estimates(rec, path);
     PlotData plot;
     const AuditResult r = run_audit(rec, AuditOptions{}, plots_dir.empty() ? nullptr : &plot);
     const double secs =

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "audit/calibration_writer.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <span>
 
 namespace hrg::audit {
 
@@ -40,21 +43,67 @@ void set(fw::CalibrationFile& out, const char* key, double value, double sigma, 
   out.sigma[i] = std::fabs(sigma * scale);
 }
 
-void set_feedthrough(fw::CalibrationFile& out, const Finding& f, double pump_phase_rad,
-                     std::vector<std::string>& comments) {
-  const std::complex<double> rot = std::polar(1.0, -pump_phase_rad);
+// The audit's estimate and, when the firmware made its own, the two combined
+// (combine_estimates), with the comment that says how.
+CombinedEstimate with_firmware(std::span<const double> audit, double sigma, const double* firmware,
+                               double firmware_sigma, const std::string& what,
+                               const std::string& unit, std::vector<std::string>& comments) {
+  CombinedEstimate c;
+  std::copy(audit.begin(), audit.end(), c.value.begin());
+  c.sigma = sigma;
+  if (firmware == nullptr) return c;
+  const std::span<const double> fw(firmware, audit.size());
+  if (!(sigma > 0.0)) {
+    comments.push_back("not combined: " + what +
+                       ": the audit's estimate has no sigma; the "
+                       "audit's value is written");
+    return c;
+  }
+  c = combine_estimates(audit, sigma, fw, firmware_sigma);
+  comments.push_back(describe_combination(what, audit, sigma, fw, firmware_sigma, c, unit));
+  return c;
+}
+
+void set_feedthrough(fw::CalibrationFile& out, const Finding& f,
+                     const CalibrationWriterOptions& opt, std::vector<std::string>& comments) {
+  const std::complex<double> rot = std::polar(1.0, -opt.pump_phase_rad);
   const std::complex<double> cx =
       std::complex<double>(f.feedthrough_re_im[0], f.feedthrough_re_im[1]) * rot;
   const std::complex<double> cy =
       std::complex<double>(f.feedthrough_re_im[2], f.feedthrough_re_im[3]) * rot;
-  set(out, "feedthrough_x_re_v_per_v", cx.real(), f.sigma, 1.0);
-  set(out, "feedthrough_x_im_v_per_v", cx.imag(), f.sigma, 1.0);
-  set(out, "feedthrough_y_re_v_per_v", cy.real(), f.sigma, 1.0);
-  set(out, "feedthrough_y_im_v_per_v", cy.imag(), f.sigma, 1.0);
   comments.push_back(
       fmt("drive_feedthrough: per volt of the pump envelope, taken %.1f deg ahead "
           "of the wave (--pump-phase-deg); sigma is that of the larger |c|",
-          pump_phase_rad / kDegToRad));
+          opt.pump_phase_rad / kDegToRad));
+  const std::array<double, 4> audit{cx.real(), cx.imag(), cy.real(), cy.imag()};
+  const auto& edges = opt.firmware.feedthrough;
+  if (edges) {
+    comments.push_back(fmt("drive_feedthrough: the firmware's switch-off step check: %.0f edges",
+                           static_cast<double>(edges->edges)) +
+                       fmt(" through a correction in force for %.0f s, its residual added to "
+                           "that correction's feedthrough",
+                           edges->in_force_s) +
+                       fmt("; sigma %.2g", edges->check_sigma_v_per_v) +
+                       fmt(", from the edges' scatter %.2g V/V", edges->scatter_v_per_v));
+  }
+  const CombinedEstimate c =
+      with_firmware(audit, f.sigma, edges ? edges->total_v_per_v.data() : nullptr,
+                    edges ? edges->sigma_v_per_v : 0.0,
+                    "drive_feedthrough (x re, x im, y re, y im)", "V/V", comments);
+  set(out, "feedthrough_x_re_v_per_v", c.value[0], c.sigma, 1.0);
+  set(out, "feedthrough_x_im_v_per_v", c.value[1], c.sigma, 1.0);
+  set(out, "feedthrough_y_re_v_per_v", c.value[2], c.sigma, 1.0);
+  set(out, "feedthrough_y_im_v_per_v", c.value[3], c.sigma, 1.0);
+}
+
+void set_thermal_damping(fw::CalibrationFile& out, const Finding& f,
+                         const CalibrationWriterOptions& opt, std::vector<std::string>& comments) {
+  const auto& check = opt.firmware.thermal_damping;
+  const double audit[1] = {f.value};
+  const CombinedEstimate c = with_firmware(
+      audit, f.sigma, check ? &check->per_c : nullptr, check ? check->sigma_per_c : 0.0,
+      "thermal_damping (the firmware's: its damping model check)", "/degC", comments);
+  set(out, "thermal_damping_per_c", c.value[0], c.sigma, 1.0);
 }
 
 void apply_finding(fw::CalibrationFile& out, const Finding& f, const AuditResult& r,
@@ -72,21 +121,46 @@ void apply_finding(fw::CalibrationFile& out, const Finding& f, const AuditResult
       set(out, "nonlinear_damping_per_v2", f.value, f.sigma, 1.0);
       break;
     case Effect::thermal_frequency:
+      set(out, "thermal_frequency_ppm_per_c", f.value, f.sigma, 1.0);
+      set(out, "temperature_ref_c", r.temp_ref_c, 0.0, 1.0);
+      break;
     case Effect::thermal_damping:
-      set(out,
-          f.effect == Effect::thermal_frequency ? "thermal_frequency_ppm_per_c"
-                                                : "thermal_damping_per_c",
-          f.value, f.sigma, 1.0);
+      set_thermal_damping(out, f, opt, comments);
       set(out, "temperature_ref_c", r.temp_ref_c, 0.0, 1.0);
       break;
     case Effect::electrostatic_spring:
       set(out, "electrostatic_spring_hz_per_v2", f.value, f.sigma, 1.0);
       break;
-    case Effect::drive_feedthrough: set_feedthrough(out, f, opt.pump_phase_rad, comments); break;
+    case Effect::drive_feedthrough: set_feedthrough(out, f, opt, comments); break;
     case Effect::gap_harmonics:
       set(out, "gap_eps_p", f.gap_eps_pq_sigma[0], f.gap_eps_pq_sigma[2], 1.0);
       set(out, "gap_eps_q", f.gap_eps_pq_sigma[1], f.gap_eps_pq_sigma[3], 1.0);
       break;
+  }
+}
+
+bool found(const AuditResult& r, Effect e) {
+  return std::any_of(r.findings.begin(), r.findings.end(),
+                     [e](const Finding& f) { return f.effect == e; });
+}
+
+// The firmware's estimates of an effect the audit did not accept: said, not
+// applied (the file holds accepted findings only).
+void firmware_without_finding(const AuditResult& r, const CalibrationWriterOptions& opt,
+                              std::vector<std::string>& comments) {
+  if (const auto& e = opt.firmware.feedthrough; e && !found(r, Effect::drive_feedthrough)) {
+    const auto& k = e->total_v_per_v;
+    comments.push_back(fmt("not applied: the firmware's switch-off step check reads a drive "
+                           "feedthrough x %.4g %+.4gi",
+                           k[0], k[1]) +
+                       fmt(", y %.4g %+.4gi", k[2], k[3]) +
+                       fmt(" +- %.2g V/V; the audit found none", e->sigma_v_per_v));
+  }
+  if (const auto& e = opt.firmware.thermal_damping; e && !found(r, Effect::thermal_damping)) {
+    comments.push_back(
+        fmt("not applied: the firmware's damping model check reads a thermal "
+            "damping %.4g +- %.2g /degC; the audit found none",
+            e->per_c, e->sigma_per_c));
   }
 }
 
@@ -113,6 +187,7 @@ CalibrationFromAudit calibration_from_audit(const AuditResult& r, const std::str
   if (r.verdict == "ambiguous" && !r.ambiguity_experiment.empty()) {
     c.push_back("ambiguous: " + r.ambiguity_experiment);
   }
+  firmware_without_finding(r, opt, c);
   c.push_back(
       "not in the file: the baseline (frequency, damping and its anisotropy, split, "
       "angular gain) is what the estimator identifies online, not a calibration");

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "recording/recording.hpp"
 #include "recording/recording_writer.hpp"
 #include "sim_run/console.hpp"
 #include "sim_run/json.hpp"
@@ -194,7 +195,7 @@ namespace {
 
 // The switch-off step check: the residual feedthrough it measures (V/V per
 // volt of pump, against the NCO) and the step at the last edge's pump.
-void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
+void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e, const FirmwareEstimates& f) {
   w.begin_object("pump_edge");
   w.string("verdict", fw::to_string(e.verdict));
   w.integer("edges", e.edges);
@@ -203,6 +204,20 @@ void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
   w.number("residual_y_re_v_per_v", e.y_re);
   w.number("residual_y_im_v_per_v", e.y_im);
   w.number("residual_sigma_v_per_v", e.sigma_v_per_v);
+  w.number("residual_scatter_v_per_v", e.scatter_v_per_v);
+  w.number("in_force_s", e.in_force_s);
+  // The residual at the raw pickoffs and the feedthrough it is on top of
+  // (the recording's pump_edge_* keys).
+  const auto& r = f.feedthrough_residual_v_per_v;
+  const auto& k = f.feedthrough_in_force_v_per_v;
+  w.number("raw_residual_x_re_v_per_v", r.x_re);
+  w.number("raw_residual_x_im_v_per_v", r.x_im);
+  w.number("raw_residual_y_re_v_per_v", r.y_re);
+  w.number("raw_residual_y_im_v_per_v", r.y_im);
+  w.number("in_force_x_re_v_per_v", k.x_re);
+  w.number("in_force_x_im_v_per_v", k.x_im);
+  w.number("in_force_y_re_v_per_v", k.y_re);
+  w.number("in_force_y_im_v_per_v", k.y_im);
   w.number("step_v", e.step_v);
   w.number("step_sigma_v", e.step_sigma_v);
   w.number("tolerance_v", e.tolerance_v);
@@ -212,7 +227,7 @@ void pump_edge_json(JsonWriter& w, const fw::PumpEdgeStatus& e) {
 // The calibration's trial: where it came from, the check window that judged
 // it (misfits over the fit's own residual), withdrawn or not.
 void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
-                      const fw::Calibration& in_force) {
+                      const fw::Calibration& in_force, const FirmwareEstimates& f) {
   w.begin_object("calibration");
   // The pickoff map in force at the end (after a withdrawal: the identity).
   w.number("pickoff_y_gain", in_force.pickoff_y_gain);
@@ -238,6 +253,11 @@ void calibration_json(JsonWriter& w, const fw::app::CalibrationStatus& c,
   w.number("damping_refuted_s", c.damping_refuted_s);
   w.number("thermal_damping_per_c", in_force.thermal_damping_per_c);
   w.number("nonlinear_damping_per_v2", in_force.nonlinear_damping_per_v2);
+  // The damping check's own thermal coefficient (the recording's
+  // damping_check_* keys): its factor times the beta given.
+  w.boolean("damping_check_thermal", f.thermal_damping);
+  w.number("damping_check_thermal_damping_per_c", f.thermal_damping_per_c);
+  w.number("damping_check_thermal_damping_sigma_per_c", f.thermal_damping_sigma_per_c);
   w.boolean("gap_refuted", c.gap_refuted);
   w.number("gap_refuted_s", c.gap_refuted_s);
   w.number("gap_eps_p", in_force.gap_eps_p);
@@ -420,8 +440,8 @@ std::string report_json(const RunConfig& job, const RunResult& r) {
   // The calibration in force (CRC-32 of its canonical form, as hrg
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
-  calibration_json(w, r.calibration, r.final_calibration);
-  pump_edge_json(w, r.pump_edge);
+  calibration_json(w, r.calibration, r.final_calibration, r.firmware_estimates);
+  pump_edge_json(w, r.pump_edge, r.firmware_estimates);
   self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
   w.end_object();
   identification_json(w, r);
@@ -497,10 +517,48 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
        row.out_error_deg};
 }
 
+using Metadata = std::vector<std::pair<std::string, std::string>>;
+
+// The firmware's own estimates (FirmwareEstimates) as header keys, for
+// hrg audit --calibration (tools/audit/README.md): absent when not measured.
+void firmware_estimate_metadata(const FirmwareEstimates& e, const fw::PumpEdgeStatus& edges,
+                                Metadata& meta) {
+  const auto put = [&](const char* key, double v) {
+    meta.emplace_back(key, recording::format_number(v));
+  };
+  if (e.feedthrough) {
+    const auto& r = e.feedthrough_residual_v_per_v;
+    const auto& k = e.feedthrough_in_force_v_per_v;
+    meta.emplace_back("pump_edge_edges", std::to_string(edges.edges));
+    put("pump_edge_x_re_v_per_v", r.x_re);
+    put("pump_edge_x_im_v_per_v", r.x_im);
+    put("pump_edge_y_re_v_per_v", r.y_re);
+    put("pump_edge_y_im_v_per_v", r.y_im);
+    put("pump_edge_sigma_v_per_v", edges.sigma_v_per_v);
+    put("pump_edge_scatter_v_per_v", edges.scatter_v_per_v);
+    put("pump_edge_in_force_s", edges.in_force_s);
+    put("pump_edge_in_force_x_re_v_per_v", k.x_re);
+    put("pump_edge_in_force_x_im_v_per_v", k.x_im);
+    put("pump_edge_in_force_y_re_v_per_v", k.y_re);
+    put("pump_edge_in_force_y_im_v_per_v", k.y_im);
+  }
+  if (e.thermal_damping) {
+    put("damping_check_thermal_damping_per_c", e.thermal_damping_per_c);
+    put("damping_check_thermal_damping_sigma_per_c", e.thermal_damping_sigma_per_c);
+  }
+}
+
 std::vector<std::pair<std::string, std::string>> telemetry_metadata(const RunConfig& job) {
   return {{"source", "hrg sim (firmware + sim_target in lockstep)"},
           {"scenario", job.description},
           {"quad_v", "a_B, the quadrature wave amplitude"}};
+}
+
+// The run's header: the above and the firmware's own estimates.
+Metadata telemetry_metadata(const RunConfig& job, const RunResult& r) {
+  Metadata meta = telemetry_metadata(job);
+  firmware_estimate_metadata(r.firmware_estimates, r.pump_edge, meta);
+  return meta;
 }
 
 }  // namespace
@@ -510,7 +568,7 @@ std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& 
                                                    const TelemetryFileOptions& o) {
   // Streamed row by row: an hour of telemetry is not held twice in memory.
   std::vector<std::filesystem::path> files;
-  auto meta = telemetry_metadata(job);
+  auto meta = telemetry_metadata(job, r);
   const std::size_t every = o.decimate > 1 ? o.decimate : 1;
   if (every > 1)
     meta.emplace_back("decimation", fmt("every %zu-th row of %.0f Hz", every, job.telemetry_hz));
@@ -545,7 +603,7 @@ std::vector<std::filesystem::path> write_telemetry(const std::filesystem::path& 
 recording::Recording telemetry_recording(const RunConfig& job, const RunResult& r) {
   recording::Recording rec(telemetry_columns(), job.firmware.chain.f_center_hz,
                            job.firmware.gyro.angular_gain);
-  for (const auto& [key, value] : telemetry_metadata(job))
+  for (const auto& [key, value] : telemetry_metadata(job, r))
     rec.set_metadata(key, value);
   std::vector<double> v;
   for (const TelemetryRow& row : r.rows) {

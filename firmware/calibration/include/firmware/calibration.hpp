@@ -117,6 +117,13 @@ bool pickoff_correction(const Calibration& c, dsp::PickoffCorrection<double>& ou
 bool pickoff_correction_q30(const Calibration& c, dsp::PickoffCorrectionQ30& out);
 // The feedthrough part, V/V.
 dsp::FeedthroughCoefficients<double> feedthrough_coefficients(const Calibration& c);
+// A residual feedthrough read on the corrected quadratures (fw::PumpEdgeCheck)
+// referred to the raw pickoffs, where the calibration's feedthrough acts (it
+// is removed before the pickoff map's inverse): X passes that inverse
+// unchanged, Y_raw = (1 + g) e^{-i phi} (cos2b Y + sin2b X). Adding the
+// result to feedthrough_coefficients(c) gives the feedthrough the edges saw.
+dsp::FeedthroughCoefficients<double> residual_at_raw_pickoffs(
+    const Calibration& c, const dsp::FeedthroughCoefficients<double>& corrected);
 
 // The resonator part, as the catalogue defines it, at what the firmware
 // measures (for feed-forward and the estimator's regressors):

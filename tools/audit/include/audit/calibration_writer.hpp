@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "audit/audit.hpp"
+#include "audit/firmware_estimates.hpp"
 #include "firmware/calibration_file.hpp"
 
 namespace hrg::audit {
@@ -22,6 +23,10 @@ struct CalibrationWriterOptions {
   // feedthrough against the wave's phase; the firmware removes it per volt
   // of its actual pump envelope: k = c_audit e^{-i pump_phase}.
   double pump_phase_rad = std::numbers::pi / 4.0;
+  // The firmware's own estimates from the recording's header
+  // (firmware_estimates): where the audit found the same effect, the value
+  // written is the two combined (combine_estimates), said in a comment.
+  FirmwareEstimates firmware{};
 };
 
 struct CalibrationFromAudit {

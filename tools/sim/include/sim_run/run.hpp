@@ -143,6 +143,28 @@ struct TaskFigures {
   uint64_t runs = 0;
 };
 
+// The firmware's own estimates of what a calibration holds, beside the
+// audit's (tools/audit/README.md, "--calibration"): the switch-off step
+// check's residual feedthrough, referred to the raw pickoffs, on top of the
+// feedthrough in force while its edges were read; the damping model check's
+// thermal damping (its factor times the beta in force; only when the
+// calibration's damping part is that alone).
+struct FirmwareEstimates {
+  bool feedthrough = false;  // at least one switch-off edge measured
+  dsp::FeedthroughCoefficients<double> feedthrough_residual_v_per_v{};
+  dsp::FeedthroughCoefficients<double> feedthrough_in_force_v_per_v{};
+  bool thermal_damping = false;
+  double thermal_damping_per_c = 0.0;
+  double thermal_damping_sigma_per_c = 0.0;
+};
+
+// The firmware's estimates at the end of a run with calibration `loaded`
+// (the one given at power-up) and `in_force` (at the end).
+FirmwareEstimates firmware_estimates(const fw::PumpEdgeStatus& edges,
+                                     const fw::app::CalibrationStatus& guard,
+                                     const fw::Calibration& loaded,
+                                     const fw::Calibration& in_force);
+
 struct RunResult {
   bool reached_operate = false;
   double t_operate_s = -1.0;  // first time in operate
@@ -187,8 +209,10 @@ struct RunResult {
   est::PickoffSelfCalResult self_calibration{};
   fw::app::SelfCalibrationStatus self_calibration_applied{};
   fw::Calibration final_calibration{};
-  fw::PumpEdgeStatus
-      pump_edge{};  // the switch-off step check at the end  // the calibration in force at the end
+  fw::PumpEdgeStatus pump_edge{};  // the switch-off step check at the end
+  // What the firmware itself read of a calibration's values, for the next
+  // hrg audit --calibration (the recording's header, report.json).
+  FirmwareEstimates firmware_estimates{};
   std::vector<TelemetryRow> rows;
   std::vector<ParkResult> parks;
   BiasFit fit_raw, fit_comp, fit_model;
