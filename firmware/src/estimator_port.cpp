@@ -92,8 +92,20 @@ void EstimatorPort::add_sample(const ChainRecord& s) {
   if (shadow_) (void)seed_est_.add_sample(wave_sample(s, 1.0));
   if (est_.add_sample(w) == est::Status::ok) {
     (void)self_cal_.add_sample(w);
-    (void)model_check_.add_sample(w);
+    (void)model_check_.add_sample(has_damping_model(model_) ? w : wave_sample(s, probe_scale()));
   }
+}
+
+double EstimatorPort::probe_scale() const {
+  // No sensor: k = 1, nothing for the check to see.
+  return temp_valid_ ? 1.0 + kThermalProbePerC * (temp_c_ - model_.temperature_ref_c) : 1.0;
+}
+
+EstimatorPort::ThermalDampingReading EstimatorPort::thermal_damping_reading() const {
+  const est::DampingModelCheckResult& d = model_check_result_;
+  if (d.status != est::Status::ok || model_.nonlinear_damping_per_v2 != 0.0) return {};
+  const double beta = has_damping_model(model_) ? model_.thermal_damping_per_c : kThermalProbePerC;
+  return {true, d.factor * beta, d.factor_sigma * std::fabs(beta)};
 }
 
 void EstimatorPort::end_window() {

@@ -87,3 +87,21 @@ TEST(ThermalLoop, TheThermalDampingCoefficientRemovesItsBiasAndAWrongSignIsRefut
   DOUBLES_EQUAL(seed_comp, wrong_comp, 0.1 * seed_comp);
   CHECK(raw > 20.0 * right_comp);
 }
+
+TEST(ThermalLoop, WithoutACoefficientTheDampingCheckReadsItThroughItsProbe) {
+  // GIVEN no calibration: the check tries a thermal damping of 0.01 /degC
+  // about the reference temperature (nothing applied)
+  const RunResult seed = with_coefficient(0.0);
+  const hrg::sim_run::FirmwareEstimates& e = seed.firmware_estimates;
+  std::printf("thermal damping read without a coefficient: %.5f +- %.5f /degC\n",
+              e.thermal_damping_per_c, e.thermal_damping_sigma_per_c);
+  // THEN it reads the truth (4 sigma), finer than the audit on the same
+  // telemetry (measured 0.00429 +- 0.00030 against the audit's 0.00433 +-
+  // 0.00054)
+  CHECK_TRUE(e.thermal_damping);
+  DOUBLES_EQUAL(kBetaPerC, e.thermal_damping_per_c, 4.0 * e.thermal_damping_sigma_per_c);
+  CHECK(e.thermal_damping_sigma_per_c > 0.0 && e.thermal_damping_sigma_per_c < 4e-4);
+  // ... and the guard judges nothing: no damping part is in force
+  CHECK_FALSE(seed.calibration.damping_model);
+  CHECK_FALSE(seed.calibration.damping_refuted);
+}

@@ -59,6 +59,21 @@ class EstimatorPort final : public ResonatorIdentifier {
   // windows (campaign and check windows alike) better than none
   // (est::DampingModelCheck), re-solved after every window.
   const est::DampingModelCheckResult& damping_model_check() const { return model_check_result_; }
+  // Without a damping part in force the check tries one: a thermal damping
+  // of kThermalProbePerC about the calibration's reference temperature (no
+  // part of the model, nothing applied), so that its factor times that is
+  // the firmware's own reading of the coefficient; the guard judges the
+  // check only with a damping part in force.
+  static constexpr double kThermalProbePerC = 0.01;
+  // The thermal damping coefficient the check reads (1/degC, 1 sigma): f
+  // times the probe's or the calibration's beta; not valid before the check
+  // solves, or with a nonlinear damping in force (f scales both terms).
+  struct ThermalDampingReading {
+    bool valid = false;
+    double per_c = 0.0;
+    double sigma_per_c = 0.0;
+  };
+  ThermalDampingReading thermal_damping_reading() const;
   // The model and D_Phi forget every window (the signals or the model they
   // are referred to changed); the self-calibration keeps its windows.
   void restart_model();
@@ -89,6 +104,8 @@ class EstimatorPort final : public ResonatorIdentifier {
 
  private:
   void end_side_windows();
+  // The damping scale of the thermal probe at the measured temperature.
+  double probe_scale() const;
   void add_control_sample(est::Estimator& e, const ChainRecord& s, double scale, bool gap);
 
   est::Estimator::Config cfg_;

@@ -147,8 +147,7 @@ struct TaskFigures {
 // audit's (tools/audit/README.md, "--calibration"): the switch-off step
 // check's residual feedthrough, referred to the raw pickoffs, on top of the
 // feedthrough in force while its edges were read; the damping model check's
-// thermal damping (its factor times the beta in force; only when the
-// calibration's damping part is that alone).
+// thermal damping (fw::EstimatorPort::thermal_damping_reading).
 struct FirmwareEstimates {
   bool feedthrough = false;  // at least one switch-off edge measured
   dsp::FeedthroughCoefficients<double> feedthrough_residual_v_per_v{};
@@ -158,11 +157,10 @@ struct FirmwareEstimates {
   double thermal_damping_sigma_per_c = 0.0;
 };
 
-// The firmware's estimates at the end of a run with calibration `loaded`
-// (the one given at power-up) and `in_force` (at the end).
+// The firmware's estimates at the end of a run, the calibration `in_force`
+// then.
 FirmwareEstimates firmware_estimates(const fw::PumpEdgeStatus& edges,
-                                     const fw::app::CalibrationStatus& guard,
-                                     const fw::Calibration& loaded,
+                                     const fw::EstimatorPort::ThermalDampingReading& thermal,
                                      const fw::Calibration& in_force);
 
 struct RunResult {
