@@ -13,6 +13,7 @@
 #include <numbers>
 #include <string>
 
+#include "sim_run/report.hpp"
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
@@ -60,6 +61,12 @@ void calibrate(RunConfig& j, double scale) {
 }
 
 RunResult simulate(const RunConfig& j) { return hrg::sim_run::run_simulation(j, {}); }
+
+// A number of the recording's header (0 when absent).
+double header(const hrg::recording::Recording& rec, const std::string& key) {
+  const std::string v = rec.metadata_value(key);
+  return v.empty() ? 0.0 : std::stod(v);
+}
 
 bool ever_valid(const RunResult& r) {
   for (const auto& row : r.rows)
@@ -127,4 +134,35 @@ TEST(FeedthroughDoNoHarm, AWrongSignOrThreeTimesTheFeedthroughIsWithdrawnAndNeve
     CHECK(r.pump_edge.verdict == PumpEdgeVerdict::step);
     CHECK_FALSE(ever_valid(r));
   }
+}
+
+TEST(FeedthroughDoNoHarm, TheRecordingsHeaderCarriesTheResidualOnTopOfWhatWasInForce) {
+  // GIVEN a file with 97 % of the feedthrough: a step of 3 % of it, 9e-5 V
+  // at 3 V of pump, below the tolerance: kept
+  RunConfig j = first_minute(true);
+  calibrate(j, 0.97);
+  const RunResult r = simulate(j);
+  CHECK(r.calibration.verdict != CalibrationVerdict::withdrawn);
+  CHECK(r.pump_edge.edges >= 3);
+  // THEN the header holds the residual, ~3 % of the truth, the 97 % in
+  // force, and their sum is the truth (as the check reads it uncorrected)
+  const hrg::recording::Recording rec = hrg::sim_run::telemetry_recording(j, r);
+  LONGS_EQUAL(r.pump_edge.edges, static_cast<long>(header(rec, "pump_edge_edges")));
+  const double tol = 0.01 * std::abs(kX) + 4.0 * r.pump_edge.sigma_v_per_v;
+  DOUBLES_EQUAL(0.03 * kX.real(), header(rec, "pump_edge_x_re_v_per_v"), tol);
+  DOUBLES_EQUAL(0.97 * kX.real(), header(rec, "pump_edge_in_force_x_re_v_per_v"), 1e-15);
+  const auto total = [&](const char* part) {
+    return header(rec, std::string("pump_edge_") + part + "_v_per_v") +
+           header(rec, std::string("pump_edge_in_force_") + part + "_v_per_v");
+  };
+  DOUBLES_EQUAL(kX.real(), total("x_re"), tol);
+  DOUBLES_EQUAL(kX.imag(), total("x_im"), tol);
+  DOUBLES_EQUAL(kY.real(), total("y_re"), tol);
+  DOUBLES_EQUAL(kY.imag(), total("y_im"), tol);
+  DOUBLES_EQUAL(r.pump_edge.sigma_v_per_v, header(rec, "pump_edge_sigma_v_per_v"), 0.0);
+  // ... the file in force from the start: the check's whole run
+  CHECK(header(rec, "pump_edge_in_force_s") > 0.95 * kRunS);
+  // ... and no thermal damping reading (a constant temperature: nothing for
+  // the damping check to see)
+  CHECK_TRUE(rec.metadata_value("damping_check_thermal_damping_per_c").empty());
 }
