@@ -206,6 +206,12 @@ bool ProfileCursor::constant_over(double t0_s, double t1_s, double& value) {
   return segment_ == 0 || segment_ == pts.size() || pts[segment_ - 1].value == pts[segment_].value;
 }
 
+double ProfileCursor::piece_end_s(double t_s) {
+  if (p_->kind_ == Profile::Kind::sine) return -std::numeric_limits<double>::infinity();
+  value(t_s, false, 0.0);  // constant, steps and ramps: finds the segment
+  return hi_s_;
+}
+
 double ProfileCursor::sine_value(double t_s, bool next_step, double step_s) {
   const Profile& p = *p_;
   const double w = 2.0 * std::numbers::pi * p.freq_hz_;
