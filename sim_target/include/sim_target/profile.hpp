@@ -145,6 +145,10 @@ class ProfileCursor {
   // for many instants in a pass of its own. -infinity for a sine (no piece;
   // its cursor state is left untouched).
   double piece_end_s(double t_s);
+  // Profile::integral over [t0_s, t1_s], the same number: steps and ramps
+  // piece by piece from the cached segment (a search only where a piece
+  // ends, none for a span inside one piece), constant and sine in closed form.
+  double integral(double t0_s, double t1_s);
 
  private:
   double value_searched(double t_s, bool next_step, double step_s);
