@@ -26,7 +26,8 @@
 // 0.05 rad/s or the frequency by more than 1e-3 rad/s, which keeps the
 // neglected terms below 1e-15 per step. Cost per sample: one 8x4
 // matrix-vector product (the propagator at the present rate, formed only when
-// the rate changes, stacked with the pump sensitivity), the
+// the rate changes, stacked with the pump sensitivity; on a ramp, formed in
+// registers inside step_block()'s loop), the
 // rate and temperature from profile cursors (no search, no clock), and a
 // running <V^2> sum re-added exactly every kHistory steps (its rounding drift
 // stays below 2 kHistory eps max(V^2) = 1.2e-11 V^2 at 10 V of pump).
