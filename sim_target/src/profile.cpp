@@ -123,19 +123,8 @@ double Profile::integral(double t0_s, double t1_s) const {
     return base +
            amplitude_ / w * (std::cos(w * t0_s + phase_rad_) - std::cos(w * t1_s + phase_rad_));
   }
-  // Piecewise: constant (steps) or linear (ramps) between corners.
-  double sum = 0.0;
-  double t = t0_s;
-  while (t < t1_s) {
-    const double e = std::min(t1_s, next_breakpoint_s(t));
-    if (kind_ == Kind::steps) {
-      sum += value(0.5 * (t + e)) * (e - t);
-    } else {
-      sum += 0.5 * (value(t) + value(e)) * (e - t);
-    }
-    t = e;
-  }
-  return sum;
+  ProfileCursor pieces(this);
+  return pieces.integral(t0_s, t1_s);
 }
 
 double Profile::next_breakpoint_s(double t_s) const {
@@ -204,6 +193,33 @@ bool ProfileCursor::constant_over(double t0_s, double t1_s, double& value) {
   // A ramp segment between equal values: a + u (b - a) = a for every u.
   const auto& pts = p.points_;
   return segment_ == 0 || segment_ == pts.size() || pts[segment_ - 1].value == pts[segment_].value;
+}
+
+double ProfileCursor::piece_end_s(double t_s) {
+  if (p_->kind_ == Profile::Kind::sine) return -std::numeric_limits<double>::infinity();
+  value(t_s, false, 0.0);  // constant, steps and ramps: finds the segment
+  return hi_s_;
+}
+
+double ProfileCursor::integral(double t0_s, double t1_s) {
+  const Profile& p = *p_;
+  if (p.kind_ == Profile::Kind::constant || p.kind_ == Profile::Kind::sine) {
+    return p.integral(t0_s, t1_s);
+  }
+  // Piecewise: constant (steps) or linear (ramps) between corners.
+  double sum = 0.0;
+  double t = t0_s;
+  while (t < t1_s) {
+    const double e = std::min(t1_s, piece_end_s(t));  // next_breakpoint_s(t)
+    if (p.kind_ == Profile::Kind::steps) {
+      sum += value(0.5 * (t + e), false, 0.0) * (e - t);
+    } else {
+      const double a = value(t, false, 0.0);
+      sum += 0.5 * (a + value(e, false, 0.0)) * (e - t);
+    }
+    t = e;
+  }
+  return sum;
 }
 
 double ProfileCursor::sine_value(double t_s, bool next_step, double step_s) {

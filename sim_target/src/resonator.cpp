@@ -261,6 +261,33 @@ bool Resonator::inputs_held(std::size_t n, double dt_s, double& rate_rad_s, doub
          temp_at_.constant_over(t_first, t_last, temp_c);
 }
 
+std::size_t Resonator::ramp_run(std::size_t n, double dt_s, double* d_rate) {
+  if (!kPlainMatchesEigen || pickoff_effects_ || n == 0 || dt_s != step_s_ || dt_s != dt_last_)
+    return 0;
+  if (effects_.duffing_stiffness.enabled || effects_.nonlinear_damping.enabled) return 0;
+  if (rate_.kind() == Profile::Kind::sine) return 0;
+  if (rate_at_.profile() != &rate_) rate_at_.bind(&rate_);
+  if (temp_at_.profile() != &temp_) temp_at_.bind(&temp_);
+  // The step midpoints as step() computes them.
+  const auto t_mid = [this, dt_s](std::size_t k) {
+    return t0_s_ + static_cast<double>(steps_ + k) * step_s_ + 0.5 * dt_s;
+  };
+  double temp_c = 0.0;
+  if (!temp_at_.constant_over(t_mid(0), t_mid(n - 1), temp_c)) return 0;
+  const double piece_end_s = rate_at_.piece_end_s(t_mid(0));
+  const HeldCoefficients c = prepare_held(rate_at_.value(t_mid(0), false, dt_s), temp_c, dt_s);
+  if (c.iso != 0.0 || c.damp != 0.0) return 0;
+  std::size_t k = 0;
+  for (; k < n; ++k) {
+    const double t = t_mid(k);
+    if (!(t < piece_end_s)) break;
+    const double rate = rate_at_.value(t, true, dt_s);
+    if (std::abs(rate - rate_c_) > kRateReexpandRadS) break;
+    d_rate[k] = rate - rate_c_;
+  }
+  return k;
+}
+
 Resonator::HeldCoefficients Resonator::prepare_held(double rate_rad_s, double temp_c, double dt_s) {
   const double w = detail::thermal_omega(params_, effects_, temp_c);
   prepare_step(rate_rad_s, w, dt_s);

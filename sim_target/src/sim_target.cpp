@@ -55,6 +55,7 @@ void SimTarget::configure(const SimConfig& c) {
   pattern_angle_rad_ = c.initial.theta_rad;
   last_theta_rad_ = c.initial.theta_rad;
   input_angle_rad_ = 0.0;
+  input_rate_.bind(&config_.rate_rad_s);
   last_pump_v_ = 0.0;
   counters_ = {};
   stage_times_ = {};
@@ -63,6 +64,7 @@ void SimTarget::configure(const SimConfig& c) {
 
 void SimTarget::set_rate_profile(Profile rate_rad_s) {
   config_.rate_rad_s = rate_rad_s;
+  input_rate_.bind(&config_.rate_rad_s);
   resonator_.set_rate_profile(std::move(rate_rad_s));
 }
 void SimTarget::set_temperature_profile(Profile temp_c) {
@@ -410,7 +412,7 @@ Status SimTarget::produce_block(std::span<hal::q31_t> frames, uint64_t& t_first_
   }
   // Input angle: the exact integral of the rate profile over the block.
   const double t1 = time_s();
-  input_angle_rad_ += config_.rate_rad_s.integral(t0, t1);
+  input_angle_rad_ += input_rate_.integral(t0, t1);
   cplx x;
   cplx y;
   resonator_.envelopes(x, y);

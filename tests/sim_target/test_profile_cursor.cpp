@@ -3,6 +3,7 @@
 // and steps give Profile::value's bits; a sine advanced by rotation stays
 // within the stated bound amplitude (kReanchorSteps 4 eps + 4 eps |phase|)
 // over one hour of 100 kHz steps.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,27 @@
 #include "support/cpputest.hpp"
 
 using namespace hrg::sim;
+
+namespace {
+
+// Profile::integral as it was before the cursor took it over: a search for
+// each breakpoint and each value.
+double searched_integral(const Profile& p, double t0_s, double t1_s) {
+  double sum = 0.0;
+  double t = t0_s;
+  while (t < t1_s) {
+    const double e = std::min(t1_s, p.next_breakpoint_s(t));
+    if (p.kind() == Profile::Kind::steps) {
+      sum += p.value(0.5 * (t + e)) * (e - t);
+    } else {
+      sum += 0.5 * (p.value(t) + p.value(e)) * (e - t);
+    }
+    t = e;
+  }
+  return sum;
+}
+
+}  // namespace
 
 TEST_GROUP(ProfileCursor){};
 
@@ -75,4 +97,31 @@ TEST(ProfileCursor, ConstantOverHoldsOnlyWhereTheValueCannotChange) {
   CHECK_EQUAL(2.0, v);
   CHECK_FALSE(s.constant_over(2.0, 3.0, v));  // the jump at 3 s is inside
   CHECK_FALSE(c.constant_over(0.0, 1e-5, v));
+}
+
+TEST(ProfileCursor, IntegralBlockByBlockGivesTheBitsOfTheSearchedIntegral) {
+  // Spans of 1 ms (the board's blocks) through corners, a span over several
+  // pieces, one before the first point and one back in time: the cursor's
+  // integral against a search per breakpoint and per value, to the bit.
+  const Profile ramps =
+      Profile::ramps({{0.5, 0.0}, {2.0, 4.0}, {3.0, 4.0}, {3.5, -1.0}}).add_offset(0.25);
+  const Profile steps = Profile::steps({{1.0, 2.0}, {3.0, -1.0}});
+  for (const Profile* p : {&ramps, &steps}) {
+    ProfileCursor c(p);
+    for (int k = 0; k < 4000; ++k) {
+      const double t0 = k * 1e-3;
+      const double t1 = (k + 1) * 1e-3;
+      CHECK_EQUAL(searched_integral(*p, t0, t1), c.integral(t0, t1));
+    }
+    CHECK_EQUAL(searched_integral(*p, 0.1, 3.7), c.integral(0.1, 3.7));
+    CHECK_EQUAL(searched_integral(*p, 0.2, 0.3), c.integral(0.2, 0.3));
+    CHECK_EQUAL(searched_integral(*p, 2.9, 3.2), p->integral(2.9, 3.2));
+  }
+  // Constant and sine: the closed forms.
+  const Profile sine = Profile::sine(1.0, 1.0, 0.3);
+  ProfileCursor c(&sine);
+  CHECK_EQUAL(sine.integral(0.1, 0.35), c.integral(0.1, 0.35));
+  // ramps: 0.25 * 3.5 + the trapezoids 3 + 4 + 0.75 = 8.625 over [0, 3.5]
+  ProfileCursor r(&ramps);
+  DOUBLES_EQUAL(8.625, r.integral(0.0, 3.5), 1e-14);
 }

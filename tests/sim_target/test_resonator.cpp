@@ -4,6 +4,7 @@
 #include <cmath>
 #include <array>
 #include <complex>
+#include <utility>
 
 #include "free_decay_rates.hpp"
 #include "sim_target/averaged_model.hpp"
@@ -228,6 +229,40 @@ TEST(Resonator, StepBlockGivesTheBitsOfStepByStepOnEveryHeldPath) {
     r.set_rate_profile(Profile::constant(0.1));
     r.set_temperature_profile(Profile::constant(p.temp_ref_c + 3.0));
     r.set_standing_wave(1.0, 0.3, 0.01);
+    check_block_against_steps(r);
+  }
+}
+
+TEST(Resonator, StepBlockGivesTheBitsOfStepByStepWhileTheRateRamps) {
+  // The ramp path (each step's propagator formed in registers): a rise at
+  // 50 rad/s^2 (a re-expansion every 100 steps, inside the blocks), a flat
+  // piece, a fall at 250 rad/s^2 (one every 20 steps), corners inside the
+  // blocks, then a hold. Plain with the spring, and with a thermal
+  // stiffness at a held temperature (both take the ramp path); with a
+  // pickoff effect, with a thermal damping change (declined once the step is
+  // prepared) and under a temperature ramp (all declined: step() per step).
+  ResonatorParams p;
+  p.th_mu_rad = 0.2;
+  p.th_w_rad = 0.5;
+  Effects spring;
+  spring.electrostatic_spring.enabled = true;
+  Effects thermal;
+  thermal.thermal_frequency = {true, -50.0};
+  Effects pickoff;
+  pickoff.pickoff_phase_mismatch = {true, 0.5};
+  Effects damping;
+  damping.thermal_damping = {true, 0.01};
+  const Profile rate =
+      Profile::ramps({{0.00037, 0.1}, {0.00437, 0.3}, {0.00611, 0.3}, {0.00813, -0.2}});
+  const Profile held = Profile::constant(p.temp_ref_c + 3.0);
+  const Profile warming = Profile::ramps({{0.0, p.temp_ref_c}, {0.01, p.temp_ref_c + 1.0}});
+  const std::array<std::pair<Effects, const Profile*>, 5> cases{
+      {{spring, &held}, {thermal, &held}, {pickoff, &held}, {damping, &held}, {thermal, &warming}}};
+  for (const auto& [fx, temp] : cases) {
+    Resonator r(p, ElectrodeParams{}, fx);
+    r.set_rate_profile(rate);
+    r.set_temperature_profile(*temp);
+    r.set_state(0.83, 0.56, -1.9e3, 2.7e3);  // both pickoffs, in and out of phase
     check_block_against_steps(r);
   }
 }

@@ -476,9 +476,8 @@ TEST(SimBoard, WideAndBaselineResonatorLoopsGiveTheSameBits) {
   c.adc.noise_v_rms = {1e-4, 2e-4};
   c.initial.amplitude_v = 1.0;
   c.seed = 9;
-  // Every term coupled (the rate, the axes off the pickoffs): with zero
+  // Every term coupled (a rate, the axes off the pickoffs): with zero
   // off-diagonal coefficients a changed order of the sums keeps its bits.
-  c.rate_rad_s = Profile::constant(1.0);
   c.resonator.th_w_rad = 0.3;
   c.resonator.th_mu_rad = -0.2;
   const DacQuantizer q(c.dac);
@@ -515,13 +514,21 @@ TEST(SimBoard, WideAndBaselineResonatorLoopsGiveTheSameBits) {
     }
     return words;
   };
-  const auto wide = run(true, false);
-  const bool took_wide = target().wide_kernels();
-  const auto base = run(false, false);
-  const auto wide_apart = run(true, true);
-  target().set_profiling(false);
-  CHECK(wide == base);
-  CHECK(wide_apart == base);
+  // The rate held, then ramping (each step's propagator formed in the
+  // loop; corners and re-expansions inside the blocks).
+  bool took_wide = false;
+  for (const Profile& rate :
+       {Profile::constant(1.0),
+        Profile::ramps({{0.0, 1.0}, {0.02345, 1.2}, {0.0311, 1.2}, {0.04567, 0.9}})}) {
+    c.rate_rad_s = rate;
+    const auto wide = run(true, false);
+    took_wide = target().wide_kernels();
+    const auto base = run(false, false);
+    const auto wide_apart = run(true, true);
+    target().set_profiling(false);
+    CHECK(wide == base);
+    CHECK(wide_apart == base);
+  }
   std::printf("\n  wide resonator loop %s on this CPU\n", took_wide ? "taken" : "not available");
 }
 

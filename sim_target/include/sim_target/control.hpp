@@ -20,6 +20,7 @@
 #include "hal/board.hpp"
 #include "sim_target/converters.hpp"
 #include "sim_target/noise.hpp"
+#include "sim_target/profile.hpp"
 #include "sim_target/resonator.hpp"
 #include "sim_target/sim_can.hpp"
 #include "sim_target/sim_config.hpp"
@@ -221,6 +222,7 @@ class SimTarget {
   double pattern_angle_rad_ = 0.0;
   double last_theta_rad_ = 0.0;
   double input_angle_rad_ = 0.0;
+  ProfileCursor input_rate_;  // config_.rate_rad_s for the input angle's integral, block by block
   double last_pump_v_ = 0.0;
   SimCounters counters_;
   bool profiling_ = false;

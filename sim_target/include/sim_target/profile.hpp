@@ -139,6 +139,16 @@ class ProfileCursor {
   // segment; that number goes to `value`. False for a sine (whose cursor
   // state this leaves untouched) and for a span that crosses a breakpoint.
   bool constant_over(double t0_s, double t1_s, double& value);
+  // The end of the piece that holds t_s: value() is the one expression of
+  // Profile::value over [t_s, end) (a ramp's line, a step's hold; +infinity
+  // for a constant and from the last point on), so a caller may evaluate it
+  // for many instants in a pass of its own. -infinity for a sine (no piece;
+  // its cursor state is left untouched).
+  double piece_end_s(double t_s);
+  // Profile::integral over [t0_s, t1_s], the same number: steps and ramps
+  // piece by piece from the cached segment (a search only where a piece
+  // ends, none for a span inside one piece), constant and sine in closed form.
+  double integral(double t0_s, double t1_s);
 
  private:
   double value_searched(double t_s, bool next_step, double step_s);

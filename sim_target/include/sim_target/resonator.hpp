@@ -26,13 +26,15 @@
 // 0.05 rad/s or the frequency by more than 1e-3 rad/s, which keeps the
 // neglected terms below 1e-15 per step. Cost per sample: one 8x4
 // matrix-vector product (the propagator at the present rate, formed only when
-// the rate changes, stacked with the pump sensitivity), the
+// the rate changes, stacked with the pump sensitivity; on a ramp, formed in
+// registers inside step_block()'s loop), the
 // rate and temperature from profile cursors (no search, no clock), and a
 // running <V^2> sum re-added exactly every kHistory steps (its rounding drift
 // stays below 2 kHistory eps max(V^2) = 1.2e-11 V^2 at 10 V of pump).
 //
 // Not thread-safe; copyable.
 
+#include <algorithm>
 #include <array>
 #include <complex>
 #include <cstdint>
@@ -91,9 +93,11 @@ class Resonator {
   // the same numbers as n calls of measured() and step(). When the rate and
   // the temperature hold one value over the n steps and no amplitude-
   // dependent effect is on, the per-step profile reads, re-expansion checks
-  // and coefficient updates are done once for the n steps. The sink runs
-  // inline, so the caller's per-sample work (noise, ADC) overlaps the step's
-  // dependency chain.
+  // and coefficient updates are done once for the n steps. While the rate
+  // ramps (the temperature held), the rates of a run of steps are read in a
+  // pass of their own and each step's propagator is formed in registers
+  // (step_varying()). The sink runs inline, so the caller's per-sample work
+  // (noise, ADC) overlaps the step's dependency chain.
   //
   // kWide: the held-inputs loop on four rows at a time (step_wide()), for a
   // caller compiled for AVX2 (SimTarget checks the CPU once); the same bits.
@@ -103,10 +107,7 @@ class Resonator {
     double rate = 0.0;
     double temp_c = 0.0;
     if (!inputs_held(n, dt_s, rate, temp_c)) {
-      for (std::size_t k = 0; k < n; ++k) {
-        sink(k, measured());
-        step(drives[k], dt_s);
-      }
+      step_varying<kWide>(drives, n, dt_s, sink);
       return;
     }
     const HeldCoefficients c = prepare_held(rate, temp_c, dt_s);
@@ -180,6 +181,53 @@ class Resonator {
     next += c_gap * terms.tail<4>();
     return next;
   }
+  // step_block() where the rate or the temperature changes: runs of steps on
+  // one piece of the rate profile (a ramp's line up to its corner or the
+  // next re-expansion, see ramp_run()) go through step_plain() or
+  // step_wide() with each step's propagator formed in registers; the step
+  // that ends a run (a corner, a re-expansion) and every case ramp_run()
+  // declines go through step().
+  template <bool kWide, class Sink>
+  [[gnu::always_inline]] void step_varying(const Drive* drives, std::size_t n, double dt_s,
+                                           Sink& sink) {
+    std::array<double, kRampRun> d_rate;  // each step's rate - rate_c_
+    std::size_t k = 0;
+    while (k < n) {
+      const std::size_t want = std::min(n - k, kRampRun);
+      const std::size_t m = ramp_run(want, dt_s, d_rate.data());
+      if (m == 0) break;
+      const auto shifted =
+          [&sink, k ](std::size_t j, const PickoffOutput& p) __attribute__((always_inline)) {
+        sink(k + j, p);
+      };
+      if constexpr (kWide) {
+        step_wide<true>(drives + k, m, shifted, d_rate.data());
+      } else {
+        step_plain<true>(drives + k, m, shifted, d_rate.data());
+      }
+      cursor_steps_ = steps_ - 1;
+      k += m;
+      if (m < want) {  // the corner or the re-expansion, as step() takes it
+        sink(k, measured());
+        step(drives[k], dt_s);
+        ++k;
+      }
+    }
+    for (; k < n; ++k) {
+      sink(k, measured());
+      step(drives[k], dt_s);
+    }
+  }
+  // The longest run of steps, from the present one and at most n, that
+  // step_varying() may take without step(): the plain path's conditions (no
+  // stiffness, damping, pickoff or amplitude-dependent term), the
+  // temperature held over the n steps, the rate on one piece of its profile
+  // and within the re-expansion band. Prepares the first step as step()
+  // does (re-expands there if due), then reads each step's rate at its
+  // midpoint by the cursor's expression and writes rate - rate_c_ to
+  // d_rate[0..run). 0 when the path does not apply.
+  std::size_t ramp_run(std::size_t n, double dt_s, double* d_rate);
+  static constexpr std::size_t kRampRun = 128;  // steps per ramp_run() call
   // step_plain() follows the order of Eigen's packet product on two doubles.
   // Where Eigen does not vectorise doubles in pairs (armhf: no double SIMD),
   // its scalar product sums as a tree, so the general loop is taken instead.
@@ -190,8 +238,12 @@ class Resonator {
   // the same order (Eigen's sums column by column: ((c0 u0 + c1 u1) + c2 u2)
   // + c3 u3, then the forcers, then the pump and spring term), so the same
   // bits, with the state in registers from one step to the next.
-  template <class Sink>
-  [[gnu::always_inline]] void step_plain(const Drive* drives, std::size_t n, Sink& sink) {
+  // kRamp: the rate changes from step to step; step k's propagator is
+  // Phi + dO Psi1 + dO^2 Psi2 with dO = d_rate[k], formed here per element
+  // in prepare_step()'s order ((Phi + dO Psi1) + dO^2 Psi2), the same bits.
+  template <bool kRamp = false, class Sink>
+  [[gnu::always_inline]] void step_plain(const Drive* drives, std::size_t n, Sink& sink,
+                                         const double* d_rate = nullptr) {
     using v2d = double __attribute__((vector_size(16)));
     const auto pair = [](const double* p) {
       v2d v;
@@ -201,6 +253,9 @@ class Resonator {
     const auto splat = [](double x) { return v2d{x, x}; };
     const double* r = rate_gap_.data();  // 8x4, column-major
     const double* g = gamma_.data();     // 4x2, column-major
+    const double* p0 = phi_.data();      // 4x4, column-major
+    const double* p1 = psi_rate1_.data();
+    const double* p2 = psi_rate2_.data();
     const double k_pump = electrodes_.pump_gain_per_s2_v2;
     const double k_spring = spring_k_;
     v2d pos = {u_(0), u_(1)};  // x, y
@@ -215,10 +270,23 @@ class Resonator {
       const v2d u1 = splat(pos[1]);
       const v2d u2 = splat(vel[0]);
       const v2d u3 = splat(vel[1]);
+      // Rows (i, i + 1) of column j of Phi_rate (i < 4) or Psi_gap.
+      v2d dv{};
+      v2d dd{};
+      if constexpr (kRamp) {
+        dv = splat(d_rate[k]);
+        dd = splat(d_rate[k] * d_rate[k]);
+      }
+      const auto col = [&](std::size_t j, std::size_t i) {
+        if constexpr (kRamp) {
+          if (i < 4)
+            return (pair(p0 + 4 * j + i) + dv * pair(p1 + 4 * j + i)) + dd * pair(p2 + 4 * j + i);
+        }
+        return pair(r + 8 * j + i);
+      };
       // Rows (i, i + 1) of [Phi_rate; Psi_gap] u, column by column.
       const auto rows = [&](std::size_t i) {
-        return ((pair(r + i) * u0 + pair(r + 8 + i) * u1) + pair(r + 16 + i) * u2) +
-               pair(r + 24 + i) * u3;
+        return ((col(0, i) * u0 + col(1, i) * u1) + col(2, i) * u2) + col(3, i) * u3;
       };
       const v2d fx = splat(d.forcer_x_v);
       const v2d fy = splat(d.forcer_y_v);
@@ -233,17 +301,27 @@ class Resonator {
   // the same order per row as step_plain() and Eigen, so the same bits; the
   // twelve columns stay in registers (AVX2 has sixteen of four doubles). No
   // fused multiply-add: AVX2 alone does not enable FMA, so the compiler
-  // cannot contract a product and a sum into one rounding.
-  template <class Sink>
-  [[gnu::always_inline]] void step_wide(const Drive* drives, std::size_t n, Sink& sink) {
+  // cannot contract a product and a sum into one rounding. kRamp: as in
+  // step_plain(), rows 0-3 formed per step from d_rate[k].
+  template <bool kRamp = false, class Sink>
+  [[gnu::always_inline]] void step_wide(const Drive* drives, std::size_t n, Sink& sink,
+                                        const double* d_rate = nullptr) {
     using v4d = double __attribute__((vector_size(32)));
     const double* r = rate_gap_.data();  // 8x4, column-major
     const double* g = gamma_.data();     // 4x2, column-major
     v4d phi[4];
     v4d gap[4];
+    v4d phi0[4];  // Phi, Psi1, Psi2 (kRamp)
+    v4d psi1[4];
+    v4d psi2[4];
     for (std::size_t j = 0; j < 4; ++j) {
       std::memcpy(&phi[j], r + 8 * j, sizeof(v4d));
       std::memcpy(&gap[j], r + 8 * j + 4, sizeof(v4d));
+      if constexpr (kRamp) {
+        std::memcpy(&phi0[j], phi_.data() + 4 * j, sizeof(v4d));
+        std::memcpy(&psi1[j], psi_rate1_.data() + 4 * j, sizeof(v4d));
+        std::memcpy(&psi2[j], psi_rate2_.data() + 4 * j, sizeof(v4d));
+      }
     }
     v4d gx;
     v4d gy;
@@ -259,6 +337,14 @@ class Resonator {
       const double v2_dc = pump_ring.push(d.pump_v);
       const double v2 = d.pump_v * d.pump_v;
       const double c_gap = k_pump * (v2 - v2_dc) + k_spring * v2_dc;
+      if constexpr (kRamp) {
+        const double dr = d_rate[k];
+        const double dr2 = dr * dr;
+        const v4d dv = {dr, dr, dr, dr};
+        const v4d dd = {dr2, dr2, dr2, dr2};
+        for (std::size_t j = 0; j < 4; ++j)
+          phi[j] = (phi0[j] + dv * psi1[j]) + dd * psi2[j];
+      }
       const v4d u0 = {u[0], u[0], u[0], u[0]};
       const v4d u1 = {u[1], u[1], u[1], u[1]};
       const v4d u2 = {u[2], u[2], u[2], u[2]};
