@@ -240,7 +240,6 @@ class Auditor {
   State fit_baseline(AuditResult& out);
   State adopt_block_noise(const Mask& base, State cur, AuditResult& out);
   void remove_feedthrough_pull(const State& cur, AuditResult& out);
-  void drop_ring_ups(double nu, AuditResult& out);
   void remove_angle_pull(AuditResult& out);
   void remove_frequency_pull(const State& cur, const FeedStat& ft, AuditResult& out);
   State weight_forced_segments(const Mask& base, State cur, AuditResult& out);
@@ -284,7 +283,6 @@ class Auditor {
   // of c_x, c_y), when they show one (remove_feedthrough_pull).
   bool ft_shown_ = false;
   std::array<double, 4> ft_c_{};
-  std::size_t forced_ring_ups_ = 0;  // ringing up under it, left out (drop_ring_ups)
 };
 
 bool Auditor::testable(Effect e) const {
@@ -492,42 +490,13 @@ void Auditor::remove_feedthrough_pull(const State& cur, AuditResult& out) {
   if (!ft.testable || ft.dchi2 - 4.0 * ln_neff(cur) < opt_.min_delta_bic) return;
   ft_shown_ = true;
   ft_c_ = ft.c_re_im;
-  drop_ring_ups(cur.fit.p[kNu], out);
-  if (d_.forced.size() < 3) return;
   remove_angle_pull(out);
   remove_frequency_pull(cur, ft, out);
 }
 
-// The pump's phase follows the measured wave phase, which a feedthrough
-// offsets by delta = Im(V (c_x cos 2 theta + c_y sin 2 theta)) / a_A; a pump
-// off the wave's phase by delta pulls the wave's frequency by about delta
-// times its drive c V^2 = a_A'/a_A + nu. Held, that is delta nu; ringing up
-// at the pump's limit ten times more, which the frequency model (resonator
-// only) does not hold: on the default scenario with a feedthrough of 8e-4 at
-// -45 / 110 deg (seed 1) one ring-up at 10 V (a_A'/a_A 10 nu, delta -0.010)
-// sat -2.06e-4 rad/s off (9.5 sigma; predicted about -3.3e-4) and gave a
-// false electrostatic spring of -2.8e-7 Hz/V^2 at delta BIC 72. So where
-// the switch-offs show a feedthrough, segments ringing up beyond
-// kBalanceHold nu are left out.
-void Auditor::drop_ring_ups(double nu, AuditResult& out) {
-  const auto n0 = d_.forced.size();
-  std::erase_if(d_.forced, [&](const ForcedSegment& f) {
-    return f.mean_v2 > 0.0 && f.dlna_per_s > kBalanceHold * nu;
-  });
-  const auto dropped = n0 - d_.forced.size();
-  forced_ring_ups_ = dropped;
-  if (dropped == 0) return;
-  out.notes.push_back(std::to_string(dropped) +
-                      " excitation segment(s) ringing up under the pump (a_A'/a_A above " +
-                      std::to_string(kBalanceHold).substr(0, 3) +
-                      " nu) left out: the drive feedthrough of the switch-offs puts the pump off "
-                      "the wave's phase, which pulls the frequency in proportion to the pump's "
-                      "drive");
-}
-
-// The feedthrough's in-phase part across the wave turns the measured 2 theta
+// The feedthrough's in-phase part across the vibration turns the measured 2 theta
 // by Re(V (c_y cos 2 theta - c_x sin 2 theta)) / a_A (its quadrature part
-// moves only a_B, its part along the wave the phase and a_A), so each
+// moves only a_B, its part along the vibration the phase and a_A), so each
 // segment's pattern-angle drift by the change of (Re(c_y) g_x - Re(c_x) g_y)
 // / 2 between its end rows over their span. On the default scenario's
 // feedthrough 8e-4 at -45 / 110 deg (seed 1) it predicts 1.4e-4 rad/s rms
@@ -757,11 +726,11 @@ double Auditor::balance_scatter(const std::vector<std::size_t>& use, double& se2
   return (y - h * coef).squaredNorm();
 }
 
-// The same in-phase part moves the measured a_A along the wave: ln a_A by
+// The same in-phase part moves the measured a_A along the vibration: ln a_A by
 // Re(c_x) g_x + Re(c_y) g_y, so each balance by its change between the
 // three-row ends over their span (ft_gx, ft_gy). The firmware's amplitude
 // loop holds the measured amplitude, feedthrough included, and moves the
-// true wave by what it takes out of the measured one; so the pull is taken
+// true vibration by what it takes out of the measured one; so the pull is taken
 // out only where that lowers the balances' scatter (on the default
 // scenario's 1e-3 V/V row it raised it: chi^2 243 -> 367 on 21).
 void Auditor::remove_balance_pull(const std::vector<std::size_t>& use, AuditResult& out) {
@@ -843,7 +812,7 @@ void Auditor::describe_data(AuditResult& out) const {
   out.temp_ref_c = d_.temp_ref_c;
   out.free_segments = static_cast<int>(d_.free.size());
   out.forced_segments = static_cast<int>(d_.forced.size());
-  out.forced_segments_left_out = static_cast<int>(d_.forced_jittery + forced_ring_ups_);
+  out.forced_segments_left_out = static_cast<int>(d_.forced_jittery);
   out.blocks = static_cast<int>(d_.blocks.size());
   out.samples_per_block = d_.samples_per_block;
   for (const auto& s : d_.free)

@@ -26,7 +26,7 @@ constexpr std::size_t kSlopeRows = 40;
 // proportional term the loop can then oscillate faster than the rows, which
 // alias the pump: 0.68-1.01 of its level on the segments that gave a false
 // gap harmonic (feedthrough 8e-4 at -45 / 110 deg, default scenario), where a
-// loop that holds the wave moves its pump by a few percent.
+// loop that holds the amplitude moves its pump by a few percent.
 constexpr double kMaxPumpJitter = 0.3;
 
 struct Run {
@@ -438,12 +438,13 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
     if (!runs[ri].exc && len >= kMinFreeSamples) add_free_segment(r, runs, ri, nb, d);
   }
   if (d.forced_jittery > 0) {
-    d.notes.push_back(std::to_string(d.forced_jittery) +
-                      " excitation segment(s) left out: their pump_v jitters from row to row by "
-                      "more than " +
-                      std::to_string(kMaxPumpJitter).substr(0, 3) +
-                      " of its level (an amplitude loop faster than the rows, which alias the "
-                      "pump: their pump voltage, amplitude and angle ends are not the wave's)");
+    d.notes.push_back(
+        std::to_string(d.forced_jittery) +
+        " excitation segment(s) left out: their pump_v jitters from row to row by "
+        "more than " +
+        std::to_string(kMaxPumpJitter).substr(0, 3) +
+        " of its level (an amplitude loop faster than the rows, which alias the "
+        "pump: their pump voltage, amplitude and angle ends are not the resonator's)");
   }
   // Hold out every fourth free segment (whole segments), when there are enough.
   if (d.free.size() >= 4) {
