@@ -498,11 +498,11 @@ void Auditor::remove_feedthrough_pull(const State& cur, AuditResult& out) {
 // by Re(V (c_y cos 2 theta - c_x sin 2 theta)) / a_A (its quadrature part
 // moves only a_B, its part along the vibration the phase and a_A), so each
 // segment's pattern-angle drift by the change of (Re(c_y) g_x - Re(c_x) g_y)
-// / 2 between its end rows over their span. On the default scenario's
-// feedthrough 8e-4 at -45 / 110 deg (seed 1) it predicts 1.4e-4 rad/s rms
-// against drifts of 1.33e-4 rad/s rms left by the baseline, segment by
-// segment. No free parameter (c is the switch-offs'), so it is always taken
-// out when they show a feedthrough.
+// / 2 between its end rows over their span. On the default scenario with a
+// feedthrough of 8e-4 at -45 / 110 deg (seed 1, every segment kept) it
+// predicts -3.04e-4 rad/s for a drift left by the baseline of -3.01e-4, and
+// 4.4e-5 for 4.28e-5. No free parameter (c is the switch-offs'), so it is
+// always taken out when they show a feedthrough.
 void Auditor::remove_angle_pull(AuditResult& out) {
   double ss = 0.0;
   for (auto& f : d_.forced) {
