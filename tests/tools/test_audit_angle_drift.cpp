@@ -5,13 +5,15 @@
 // with D the damping anisotropy's drift nu dmu sin 4(theta - th_mu)
 // (physics.md section 2). Read over the time between the single rows its end
 // angles are taken at, the drift sits at the white noise of those angles;
-// over the three-row means' span the audit divides by (two rows shorter) it
-// misses by 2 dt / T of K Omega / 2, far above that noise (README, Known limits).
+// over the three-row means' span (two rows shorter) it misses by 2 dt / T of
+// K Omega / 2, far above that noise; the audit's own angle residuals
+// (model.hpp) read it over the end rows' span.
 #include <cmath>
 #include <vector>
 
 #include "../../tools/audit/src/campaign.hpp"
 #include "../../tools/audit/src/dataset.hpp"
+#include "../../tools/audit/src/model.hpp"
 #include "recording/recording.hpp"
 
 #include "support/cpputest.hpp"
@@ -47,6 +49,19 @@ double chi2(const bench::Scenario& s, const detail::Dataset& d, Span span_s) {
   return c;
 }
 
+// The true resonator as the audit's parameters (no catalogue effect, pickoffs
+// ideal, so the readout distortion and the pump's gap term are zero).
+detail::Params true_params(const bench::Scenario& s) {
+  const auto& r = s.resonator;
+  detail::Params p{};
+  p[detail::kNu] = r.nu_per_s();
+  p[detail::kDnuC] = r.nu_per_s() * r.dmu * std::cos(4.0 * r.th_mu_rad);
+  p[detail::kDnuS] = r.nu_per_s() * r.dmu * std::sin(4.0 * r.th_mu_rad);
+  p[detail::kK] = r.angular_gain;
+  p[detail::kCor] = 1.0;
+  return p;
+}
+
 }  // namespace
 
 TEST_GROUP(AuditAngleDrift){};
@@ -71,4 +86,26 @@ TEST(AuditAngleDrift, ANullsExcitationSegmentDriftIsAtItsWhiteNoiseOverItsEndRow
   // are 1e-4 to 3e-4 rad/s, against a noise of about 4e-6 rad/s
   const double c_means = chi2(s, d, [](const detail::ForcedSegment& f) { return f.t1_s - f.t0_s; });
   CHECK_TRUE(c_means > 10.0 * n);
+}
+
+TEST(AuditAngleDrift, TheAuditsAngleResidualsOfANullAreAtTheirWhiteNoiseAgainstTheTrueResonator) {
+  // GIVEN the same null and the true resonator's parameters
+  auto s = bench::random_scenario(bench::Design::telemetry, 360.0, kSeed);
+  s.temp_cycles = true;
+  auto d = detail::build_dataset(bench::simulate(s), 12000);
+  for (auto& f : d.forced)
+    f.angle_sigma_rad_s = 1.0;  // every segment's drift, as the audit marks those it uses
+  // WHEN the audit's angle residuals are taken there, over their own white noise
+  const auto r = detail::angle_residuals(d, true_params(s));
+  LONGS_EQUAL(d.forced.size(), r.size());
+  double c = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const double z = r[i] / d.forced[i].angle_se_rad_s;
+    c += z * z;
+  }
+  // THEN their chi^2 is at the count (over the means' span it is over 10x it,
+  // the first test)
+  const auto n = static_cast<double>(r.size());
+  CHECK_TRUE(c < 1.5 * n);
+  CHECK_TRUE(c > n / 1.5);
 }

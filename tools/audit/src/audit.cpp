@@ -8,7 +8,9 @@
 #include <cstdlib>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -238,9 +240,13 @@ class Auditor {
   State fit_baseline(AuditResult& out);
   State adopt_block_noise(const Mask& base, State cur, AuditResult& out);
   void remove_feedthrough_pull(const State& cur, AuditResult& out);
-  State weight_forced_segments(const Mask& base, State cur);
+  void remove_angle_pull(AuditResult& out);
+  void remove_frequency_pull(const State& cur, const FeedStat& ft, AuditResult& out);
+  State weight_forced_segments(const Mask& base, State cur, AuditResult& out);
   double forced_scatter(const std::vector<double>& fr, int p) const;
-  void weight_balance();
+  void weight_balance(AuditResult& out);
+  double balance_scatter(const std::vector<std::size_t>& use, double& se2) const;
+  void remove_balance_pull(const std::vector<std::size_t>& use, AuditResult& out);
   void weight_angle(const std::vector<std::size_t>& use);
   void describe_data(AuditResult& out) const;
   std::vector<Candidate> score_candidates(const State& cur, const std::vector<Chosen>& chosen,
@@ -273,6 +279,10 @@ class Auditor {
   std::vector<const GenericTerm*> described_;      // terms of out.description, in order
   Params start_balance_{};   // the free-decay baseline the balance starts from
   bool confounded_ = false;  // a thermal effect and a drift in time cannot be told apart
+  // The drive feedthrough the switch-offs show against the baseline (Re, Im
+  // of c_x, c_y), when they show one (remove_feedthrough_pull).
+  bool ft_shown_ = false;
+  std::array<double, 4> ft_c_{};
 };
 
 bool Auditor::testable(Effect e) const {
@@ -446,7 +456,7 @@ State Auditor::fit_baseline(AuditResult& out) {
   cur = adopt_block_noise(base, cur, out);
   if (d_.forced.size() >= 3) {
     remove_feedthrough_pull(cur, out);
-    cur = weight_forced_segments(base, cur);
+    cur = weight_forced_segments(base, cur, out);
   }
   if (std::getenv("HRG_AUDIT_DEBUG")) {
     const auto fr = forced_residuals(d_, cur.fit.p);
@@ -478,6 +488,37 @@ void Auditor::remove_feedthrough_pull(const State& cur, AuditResult& out) {
   if (!d_.has_pump || !testable(Effect::drive_feedthrough)) return;
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   if (!ft.testable || ft.dchi2 - 4.0 * ln_neff(cur) < opt_.min_delta_bic) return;
+  ft_shown_ = true;
+  ft_c_ = ft.c_re_im;
+  remove_angle_pull(out);
+  remove_frequency_pull(cur, ft, out);
+}
+
+// The feedthrough's in-phase part across the vibration turns the measured 2 theta
+// by Re(V (c_y cos 2 theta - c_x sin 2 theta)) / a_A (its quadrature part
+// moves only a_B, its part along the vibration the phase and a_A), so each
+// segment's pattern-angle drift by the change of (Re(c_y) g_x - Re(c_x) g_y)
+// / 2 between its end rows over their span. On the default scenario with a
+// feedthrough of 8e-4 at -45 / 110 deg (seed 1, every segment kept) it
+// predicts -3.04e-4 rad/s for a drift left by the baseline of -3.01e-4, and
+// 4.4e-5 for 4.28e-5. No free parameter (c is the switch-offs'), so it is
+// always taken out when they show a feedthrough.
+void Auditor::remove_angle_pull(AuditResult& out) {
+  double ss = 0.0;
+  for (auto& f : d_.forced) {
+    f.angle_pull_rad_s = 0.5 * (ft_c_[2] * f.ft_ax_per_s - ft_c_[0] * f.ft_ay_per_s);
+    ss += f.angle_pull_rad_s * f.angle_pull_rad_s;
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "the drive feedthrough of the switch-offs turns the measured pattern angle of the "
+                "excitation segments: %.2g rad/s rms of drift, taken out of them",
+                std::sqrt(ss / static_cast<double>(d_.forced.size())));
+  out.notes.push_back(buf);
+}
+
+// The feedthrough's pull on the segments' measured frequency (step 2).
+void Auditor::remove_frequency_pull(const State& cur, const FeedStat& ft, AuditResult& out) {
   std::vector<double> pull;
   double ss = 0.0;
   for (const auto& f : d_.forced) {
@@ -579,7 +620,7 @@ State Auditor::adopt_block_noise(const Mask& base, State cur, AuditResult& out) 
 // what the frequency-shifting candidates could explain (pump voltage squared,
 // amplitude squared, temperature), so that the signature of an effect is not
 // counted as noise; with few segments only the pump term is taken out.
-State Auditor::weight_forced_segments(const Mask& base, State cur) {
+State Auditor::weight_forced_segments(const Mask& base, State cur, AuditResult& out) {
   start_balance_ = cur.fit.p;
   const auto fr = forced_residuals(d_, cur.fit.p);
   const std::size_t n = fr.size();
@@ -593,7 +634,7 @@ State Auditor::weight_forced_segments(const Mask& base, State cur) {
       rss / static_cast<double>(std::max<std::size_t>(1, n - static_cast<std::size_t>(p))) - se2);
   for (auto& f : d_.forced)
     f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
-  weight_balance();
+  weight_balance(out);
   eo_.use_forced = true;
   return fit_state(base, cur.fit.p, false);
 }
@@ -625,7 +666,7 @@ double Auditor::forced_scatter(const std::vector<double>& fr, int p) const {
 // e has a floor of kBalanceFloor nu x 1 s. Only segments where the amplitude
 // control holds the wave (|a_A'/a_A| <= kBalanceHeld nu) when there are
 // kBalanceMinSegments of them, else those that recover (<= kBalanceHold nu).
-void Auditor::weight_balance() {
+void Auditor::weight_balance(AuditResult& out) {
   if (!d_.has_pump) return;
   const double nu = start_balance_[kNu];
   auto segments_within = [&](double hold) {
@@ -640,24 +681,13 @@ void Auditor::weight_balance() {
   if (use.size() < kBalanceMinSegments) use = segments_within(kBalanceHold);
   const std::size_t n = use.size();
   if (n < kBalanceMinSegments) return;
-  const std::vector<double> left = balance_left(d_, start_balance_);
-  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 4);
-  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
-  double se2 = 0.0;  // the white noise's share of the weighted scatter
-  for (std::size_t k = 0; k < n; ++k) {
-    const auto& f = d_.forced[use[k]];
-    const auto r = static_cast<Eigen::Index>(k);
-    const double t = f.t1_s - f.t0_s;
-    h(r, 0) = t * f.mean_v2, h(r, 1) = t * f.mean_v2c4, h(r, 2) = t * f.mean_v2s4;
-    h(r, 3) = t * f.dlna_per_s * f.mean_v2;
-    y(r) = t * left[use[k]];
-    se2 += t * t * f.balance_se_per_s * f.balance_se_per_s / static_cast<double>(n);
-  }
-  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
-  const double rss = (y - h * coef).squaredNorm();
+  if (ft_shown_) remove_balance_pull(use, out);
+  double se2 = 0.0;
+  const double rss = balance_scatter(use, se2);
   const double floor = kBalanceFloor * nu * 1.0;
   const double e2 = std::max(floor * floor, rss / static_cast<double>(n - 4) - se2);
   if (std::getenv("HRG_AUDIT_DEBUG")) {
+    const std::vector<double> left = balance_left(d_, start_balance_);
     std::fprintf(stderr, "balance: %zu segments, e %.3g (floor %.3g), se2 %.3g\n", n, std::sqrt(e2),
                  floor, se2);
     for (std::size_t i : use) {
@@ -674,10 +704,71 @@ void Auditor::weight_balance() {
   weight_angle(use);
 }
 
+// Sum of squares the amplitude balance of segments `use` leaves, weighted by
+// T, once the pump's shapes are fitted (weight_balance); `se2` gets the white
+// noise's share of it per segment.
+double Auditor::balance_scatter(const std::vector<std::size_t>& use, double& se2) const {
+  const std::size_t n = use.size();
+  const std::vector<double> left = balance_left(d_, start_balance_);
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 4);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  se2 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& f = d_.forced[use[k]];
+    const auto r = static_cast<Eigen::Index>(k);
+    const double t = f.t1_s - f.t0_s;
+    h(r, 0) = t * f.mean_v2, h(r, 1) = t * f.mean_v2c4, h(r, 2) = t * f.mean_v2s4;
+    h(r, 3) = t * f.dlna_per_s * f.mean_v2;
+    y(r) = t * left[use[k]];
+    se2 += t * t * f.balance_se_per_s * f.balance_se_per_s / static_cast<double>(n);
+  }
+  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+  return (y - h * coef).squaredNorm();
+}
+
+// The same in-phase part moves the measured a_A along the vibration: ln a_A by
+// Re(c_x) g_x + Re(c_y) g_y, so each balance by its change between the
+// three-row ends over their span (ft_gx, ft_gy). The firmware's amplitude
+// loop holds the measured amplitude, feedthrough included, and moves the
+// true vibration by what it takes out of the measured one; so the pull is taken
+// out only where that lowers the balances' scatter (on the default
+// scenario's 1e-3 V/V row it raised it: chi^2 243 -> 367 on 21).
+void Auditor::remove_balance_pull(const std::vector<std::size_t>& use, AuditResult& out) {
+  double se2 = 0.0, ss = 0.0;
+  const double before = balance_scatter(use, se2);
+  std::vector<double> pull(d_.forced.size(), 0.0);
+  for (std::size_t i : use) {
+    const auto& f = d_.forced[i];
+    pull[i] = ft_c_[0] * f.ft_gx_per_s + ft_c_[2] * f.ft_gy_per_s;
+    ss += pull[i] * pull[i];
+  }
+  for (std::size_t i : use)
+    d_.forced[i].dlna_per_s -= pull[i];
+  const double after = balance_scatter(use, se2);
+  const bool keep = after < before;
+  if (!keep) {
+    for (std::size_t i : use)
+      d_.forced[i].dlna_per_s += pull[i];
+  }
+  char buf[240];
+  std::snprintf(buf, sizeof buf,
+                "the drive feedthrough's pull on the excitation segments' amplitude balance "
+                "(%.2g 1/s rms) %s (their scatter %.3g -> %.3g, weighted by length)",
+                std::sqrt(ss / static_cast<double>(use.size())),
+                keep ? "is taken out" : "is not taken out: it does not lower their scatter",
+                std::sqrt(before / static_cast<double>(use.size())),
+                std::sqrt(after / static_cast<double>(use.size())));
+  out.notes.push_back(buf);
+}
+
 // Weight of the pattern-angle drift of the same segments, the same way: the
 // scatter beyond the white noise once the gap's shapes (c V^2 cos/sin 4
-// theta) and an error of K (the mean rate) are taken out, as e / T, e from
-// the fit weighted by T, with a floor of kAngleFloor rad.
+// theta) and an error of K (the mean rate) are taken out, as e / T over the
+// end rows' span T, e from the fit weighted by T, with a floor of
+// kAngleFloor rad. No segment weighs more than one of the median length
+// (e / min(T, T_median)): e / T alone gave one long segment of the
+// firmware's telemetry (14 s, a drift no model term holds) 17x its weight,
+// and its pull on the baseline a false gain mismatch.
 void Auditor::weight_angle(const std::vector<std::size_t>& use) {
   for (std::size_t i : use)
     d_.forced[i].angle_sigma_rad_s = 1.0;  // marks the segments angle_residuals() takes
@@ -685,27 +776,34 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
   const std::size_t n = use.size();
   Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 3);
   Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  std::vector<double> spans;
   double se2 = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& f = d_.forced[use[k]];
     const auto row = static_cast<Eigen::Index>(k);
-    const double t = f.t1_s - f.t0_s;
+    const double t = f.angle_span_s;
     h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.mean_rate_rad_s;
     y(row) = t * r[k];
     se2 += t * t * f.angle_se_rad_s * f.angle_se_rad_s / static_cast<double>(n);
+    spans.push_back(t);
   }
   const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
   const double rss = (y - h * coef).squaredNorm();
   const double e2 = std::max(kAngleFloor * kAngleFloor, rss / static_cast<double>(n - 3) - se2);
+  auto mid = spans.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(spans.begin(), mid, spans.end());
+  const double t_median = *mid;
   if (std::getenv("HRG_AUDIT_DEBUG"))
-    std::fprintf(stderr, "angle: e %.3g rad, se2 %.3g\n", std::sqrt(e2), se2);
+    std::fprintf(stderr, "angle: e %.3g rad, se2 %.3g, median span %.3g s\n", std::sqrt(e2), se2,
+                 t_median);
   for (std::size_t k = 0; k < n; ++k) {
     auto& f = d_.forced[use[k]];
-    const double t = f.t1_s - f.t0_s;
+    const double t = std::min(f.angle_span_s, t_median);
     f.angle_sigma_rad_s = std::sqrt(f.angle_se_rad_s * f.angle_se_rad_s + e2 / (t * t));
     if (std::getenv("HRG_AUDIT_DEBUG"))
-      std::fprintf(stderr, "  %.2f-%.2f angle res %.3g sigma %.3g c4 %.2f s4 %.2f\n", f.t0_s,
-                   f.t1_s, r[k], f.angle_sigma_rad_s, f.mean_c4, f.mean_s4);
+      std::fprintf(stderr, "  %.2f-%.2f angle res %.3g sigma %.3g pull %.3g c4 %.2f s4 %.2f\n",
+                   f.t0_s, f.t1_s, r[k], f.angle_sigma_rad_s, f.angle_pull_rad_s, f.mean_c4,
+                   f.mean_s4);
   }
 }
 
@@ -714,6 +812,7 @@ void Auditor::describe_data(AuditResult& out) const {
   out.temp_ref_c = d_.temp_ref_c;
   out.free_segments = static_cast<int>(d_.free.size());
   out.forced_segments = static_cast<int>(d_.forced.size());
+  out.forced_segments_left_out = static_cast<int>(d_.forced_jittery);
   out.blocks = static_cast<int>(d_.blocks.size());
   out.samples_per_block = d_.samples_per_block;
   for (const auto& s : d_.free)

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
@@ -18,6 +20,14 @@ constexpr std::size_t kMinFreeSamples = 20;
 constexpr std::size_t kMinForcedSamples = 8;
 constexpr std::size_t kEdgeRows = 10;
 constexpr std::size_t kSlopeRows = 40;
+// Largest row-to-row jitter of pump_v over an excitation segment, relative to
+// its level (pump_jitter). A drive feedthrough closes a path from the pump
+// into the measured amplitude within one block; through the amplitude loop's
+// proportional term the loop can then oscillate faster than the rows, which
+// alias the pump: 0.68-1.01 of its level on the segments that gave a false
+// gap harmonic (feedthrough 8e-4 at -45 / 110 deg, default scenario), where a
+// loop that holds the amplitude moves its pump by a few percent.
+constexpr double kMaxPumpJitter = 0.3;
 
 struct Run {
   std::size_t first = 0, last = 0;  // inclusive rows
@@ -238,11 +248,36 @@ cplx pump_per_amplitude(const Rows& r, std::size_t i) {
   return std::polar(std::abs((*r.pump)[i]) / std::sqrt(std::max(r.a2[i], 1e-30)), 2.0 * th);
 }
 
+// Row-to-row jitter of |pump_v| over rows [q0, q1] relative to its mean: the
+// rms of its second differences over sqrt(6) (white jitter's standard
+// deviation; a pump the loop moves smoothly leaves ~0). 0 without a pump.
+double pump_jitter(const Rows& r, std::size_t q0, std::size_t q1) {
+  if (!r.pump || q1 < q0 + 2) return 0.0;
+  double level = 0.0, d2 = 0.0;
+  for (std::size_t i = q0; i <= q1; ++i)
+    level += std::abs((*r.pump)[i]);
+  for (std::size_t i = q0 + 1; i < q1; ++i) {
+    const double a =
+        std::abs((*r.pump)[i + 1]) - 2.0 * std::abs((*r.pump)[i]) + std::abs((*r.pump)[i - 1]);
+    d2 += a * a;
+  }
+  level /= static_cast<double>(q1 - q0 + 1);
+  if (!(level > 0.0)) return 0.0;
+  return std::sqrt(d2 / static_cast<double>(q1 - q0 - 1) / 6.0) / level;
+}
+
 // Mean wave frequency and mean inputs over the quiet part of an excitation run.
 void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d) {
   const auto [q0, best_len] = quiet_stretch(r, run, d);
   if (best_len < 20 || static_cast<double>(best_len) * dt_typ < 0.5) return;
   const std::size_t q1 = q0 + best_len - 1;
+  if (std::getenv("HRG_AUDIT_DEBUG"))
+    std::fprintf(stderr, "excitation %.2f-%.2f s: pump jitter %.3g of its level\n", r.t[q0],
+                 r.t[q1], pump_jitter(r, q0, q1));
+  if (pump_jitter(r, q0, q1) > kMaxPumpJitter) {
+    ++d.forced_jittery;  // its pump_v, mean V^2 and ends alias the pump
+    return;
+  }
   ForcedSegment f;
   f.first_row = q0;
   f.last_row = q1;
@@ -278,10 +313,15 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
   f.theta0_rad = r.theta[q0];
   f.theta1_rad = r.theta[q1];
-  f.se_rad_s = std::sqrt(2.0 / k) * d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30)) / (te - ts);
+  f.angle_span_s = r.t[q1] - r.t[q0];
+  const cplx dg = pump_per_amplitude(r, q1) - pump_per_amplitude(r, q0);
+  f.ft_ax_per_s = dg.real() / f.angle_span_s;
+  f.ft_ay_per_s = dg.imag() / f.angle_span_s;
+  const double row_se_rad = d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30));
+  f.se_rad_s = std::sqrt(2.0 / k) * row_se_rad / (te - ts);
   f.balance_se_per_s = f.se_rad_s;  // ln a_A and the phase see the same noise per row
-  // theta from single rows: half the phase's noise per row (theta = arg / 2), k = 1.
-  f.angle_se_rad_s = f.se_rad_s * std::sqrt(static_cast<double>(k)) / 2.0;
+  // theta from single rows: half the phase's noise per row (theta = arg / 2).
+  f.angle_se_rad_s = std::sqrt(2.0) * row_se_rad / 2.0 / f.angle_span_s;
   d.forced.push_back(f);
 }
 
@@ -396,6 +436,15 @@ Dataset build_dataset(const recording::Recording& rec, int max_blocks) {
     const std::size_t len = runs[ri].last - runs[ri].first + 1;
     if (runs[ri].exc && len >= kMinForcedSamples) add_forced_segment(r, runs[ri], dt, d);
     if (!runs[ri].exc && len >= kMinFreeSamples) add_free_segment(r, runs, ri, nb, d);
+  }
+  if (d.forced_jittery > 0) {
+    d.notes.push_back(
+        std::to_string(d.forced_jittery) +
+        " excitation segment(s) left out: their pump_v jitters from row to row by "
+        "more than " +
+        std::to_string(kMaxPumpJitter).substr(0, 3) +
+        " of its level (an amplitude loop faster than the rows, which alias the "
+        "pump: their pump voltage, amplitude and angle ends are not the resonator's)");
   }
   // Hold out every fourth free segment (whole segments), when there are enough.
   if (d.free.size() >= 4) {

@@ -49,9 +49,16 @@ struct ForcedSegment {
   double dlna_per_s = 0.0;  // (ln a_A(end) - ln a_A(start)) / (t1 - t0), ends as for the phase
   double balance_se_per_s = 0.0;     // of dlna_per_s, from the white noise
   double balance_sigma_per_s = 0.0;  // weight of the amplitude balance (0: not used)
-  double angle_se_rad_s = 0.0;       // of (theta1 - theta0)/(t1 - t0), from the white noise
-  double angle_sigma_rad_s = 0.0;    // weight of the pattern-angle drift (0: not used)
-  double mean_a2 = 0.0;              // mean a_A^2
+  // The pattern-angle drift (theta1 - theta0) / angle_span_s: its end angles
+  // are single rows, so it is read over those rows' own span (the three-row
+  // means' t1 - t0 is two rows shorter and left 2 dt / T of K Omega / 2 in it).
+  double angle_span_s = 0.0;
+  double angle_se_rad_s = 0.0;     // of the drift, from the white noise
+  double angle_sigma_rad_s = 0.0;  // weight of the pattern-angle drift (0: not used)
+  // What a drive feedthrough adds to the drift, taken out of it
+  // (Auditor::remove_feedthrough_pull; 0 when none is shown).
+  double angle_pull_rad_s = 0.0;
+  double mean_a2 = 0.0;  // mean a_A^2
   double mean_temp_c = 0.0;
   double mean_rate_rad_s = 0.0;
   // Change over the segment, per second and with the ends as for the phase,
@@ -60,6 +67,10 @@ struct ForcedSegment {
   // the frame of the wave phase) moves the measured phase by
   // Im(c_x) ft_gx + Im(c_y) ft_gy (Auditor::remove_feedthrough_pull).
   double ft_gx_per_s = 0.0, ft_gy_per_s = 0.0;
+  // The same change between the single end rows over angle_span_s: the
+  // feedthrough's in-phase part turns the measured theta by
+  // (Re(c_y) g_x - Re(c_x) g_y) / 2, so the drift by that of these.
+  double ft_ax_per_s = 0.0, ft_ay_per_s = 0.0;
 };
 
 // A switching of exc between a free-decay segment and an excitation segment.
@@ -96,6 +107,9 @@ struct Dataset {
   bool has_temp = false, has_pump = false, has_rate = false;
   double temp_span_c = 0.0, a2_span_v2 = 0.0, rate_span_rad_s = 0.0;
   int samples_per_block = 1;
+  // Excitation runs left out because their pump_v jitters from row to row
+  // by more than kMaxPumpJitter of its level (dataset.cpp, pump_jitter).
+  std::size_t forced_jittery = 0;
   std::vector<std::string> notes;
 };
 

@@ -281,10 +281,10 @@ std::vector<double> angle_residuals(const Dataset& d, const Params& p) {
     const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
     const double drift = s * (p[kDnuC] * f.mean_s4 - p[kDnuS] * f.mean_c4) +
                          0.5 * c * (p[kGapQ] * f.mean_v2c4 - p[kGapP] * f.mean_v2s4);
-    const double t = f.t1_s - f.t0_s;
+    const double t = f.angle_span_s;
     const double readout = (measured_theta(p, f.theta1_rad) - f.theta1_rad) -
                            (measured_theta(p, f.theta0_rad) - f.theta0_rad);
-    r.push_back((f.theta1_rad - f.theta0_rad - readout) / t -
+    r.push_back((f.theta1_rad - f.theta0_rad - readout) / t - f.angle_pull_rad_s -
                 0.5 * (drift - p[kK] * f.mean_rate_rad_s));
   }
   return r;

@@ -112,6 +112,8 @@ std::string to_json(const AuditResult& r) {
   if (!r.description.terms.empty()) j += ",\n  \"description\": " + description_json(r.description);
   j += ",\n  \"acceptance_rule\": " + str(r.acceptance_rule);
   j += ",\n  \"candidates\": " + json_list(r.candidates, candidate_json);
+  j += ",\n  \"excitation_segments\": " + std::to_string(r.forced_segments) +
+       ",\n  \"excitation_segments_left_out\": " + std::to_string(r.forced_segments_left_out);
   j += ",\n  \"notes\": [";
   for (std::size_t i = 0; i < r.notes.size(); ++i)
     j += (i ? ", " : "") + str(r.notes[i]);
