@@ -111,6 +111,32 @@ TEST(RecordingReader, NonNumericMetadataIsRejected) {
   LONGS_EQUAL(2, e.line());
 }
 
+// "+-x" carries two signs: from_chars would take the '-' after a stripped
+// '+', so the reader checks for it (a numeric key once reached std::stod and
+// threw past the reader's own error).
+TEST(RecordingReader, TwoSignsInANumericMetadataValueAreRejectedNamingTheKey) {
+  const auto e = error_of(replace_line(kGood, 2, "# angular_gain=+-0.554"));
+  LONGS_EQUAL(3, e.line());
+  CHECK(std::string(e.what()).find("angular_gain") != std::string::npos);
+}
+
+TEST(RecordingReader, TwoSignsInACellAreRejectedWithTheirPlace) {
+  const auto e = error_of(replace_line(kGood, 6, "0.010,1.49,+-0.002,0.003,-0.0002,0,0,8"));
+  LONGS_EQUAL(7, e.line());
+  STRCMP_EQUAL("sx_v", e.column().c_str());
+}
+
+TEST(RecordingReader, ASetNumericKeyThatIsNotANumberNamesIt) {
+  Recording r = parse_recording(kGood, "good.csv");
+  try {
+    r.set_metadata("f_ref_hz", "+-5000");
+    FAIL("set_metadata accepted two signs");
+  } catch (const std::invalid_argument& e) {
+    CHECK(std::string(e.what()).find("f_ref_hz") != std::string::npos);
+  }
+  DOUBLES_EQUAL(4999.8731, r.f_ref_hz(), 0.0);
+}
+
 TEST(RecordingReader, ShortRowIsRejected) {
   const auto e = error_of(replace_line(kGood, 5, "0.005,1.5,0.001"));
   LONGS_EQUAL(6, e.line());

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "recording/recording_writer.hpp"
 
@@ -38,7 +39,11 @@ bool parse_number(std::string_view cell, double& out, bool& not_finite) {
   not_finite = false;
   cell = trim(cell);
   if (cell.empty()) return false;
-  if (cell.front() == '+') cell.remove_prefix(1);
+  if (cell.front() == '+') {
+    cell.remove_prefix(1);
+    // from_chars takes a '-' of its own: "+-1" is two signs, not a number.
+    if (cell.empty() || cell.front() == '-') return false;
+  }
   const auto r = std::from_chars(cell.data(), cell.data() + cell.size(), out);
   if (r.ec != std::errc() || r.ptr != cell.data() + cell.size()) return false;
   if (!std::isfinite(out)) {
@@ -46,6 +51,17 @@ bool parse_number(std::string_view cell, double& out, bool& not_finite) {
     return false;
   }
   return true;
+}
+
+// The value of a numeric metadata key, parsed as strictly as a data cell.
+double number_of(const std::string& key, const std::string& value) {
+  double v = 0.0;
+  bool not_finite = false;
+  if (!parse_number(value, v, not_finite)) {
+    throw std::invalid_argument("recording: metadata '" + key + "' is not a finite number: '" +
+                                value + "'");
+  }
+  return v;
 }
 
 std::vector<std::string_view> split_commas(std::string_view line) {
@@ -172,8 +188,8 @@ std::string Recording::metadata_value(std::string_view key) const {
 }
 
 void Recording::set_metadata(const std::string& key, const std::string& value) {
-  if (key == "f_ref_hz") f_ref_hz_ = std::stod(value);
-  if (key == "angular_gain") angular_gain_ = std::stod(value);
+  if (key == "f_ref_hz") f_ref_hz_ = number_of(key, value);
+  if (key == "angular_gain") angular_gain_ = number_of(key, value);
   for (auto& [k, v] : metadata_) {
     if (k == key) {
       v = value;
