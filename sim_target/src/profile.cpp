@@ -210,10 +210,12 @@ double ProfileCursor::integral(double t0_s, double t1_s) {
   double sum = 0.0;
   double t = t0_s;
   while (t < t1_s) {
-    const double e = std::min(t1_s, piece_end_s(t));  // next_breakpoint_s(t)
+    // The piece's end is Profile::next_breakpoint_s(t), found from the cache.
+    const double e = std::min(t1_s, piece_end_s(t));
     if (p.kind_ == Profile::Kind::steps) {
       sum += value(0.5 * (t + e), false, 0.0) * (e - t);
     } else {
+      // value(t) first: it moves the cursor to t's piece before e is read.
       const double a = value(t, false, 0.0);
       sum += 0.5 * (a + value(e, false, 0.0)) * (e - t);
     }

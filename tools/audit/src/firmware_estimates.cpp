@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -30,11 +29,10 @@ class HeaderKeys {
   double number(const std::string& key, double min = -HUGE_VAL) const {
     const std::string text = rec_.metadata_value(key);
     if (text.empty()) fail(key, "is missing (the other keys of its group are there)");
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
+    double v = 0.0;
+    bool not_finite = false;
+    if (!recording::parse_number(text, v, not_finite))
       fail(key, "= '" + text + "' is not a number");
-    }
     if (!(v >= min)) fail(key, "= '" + text + "' is below its smallest value");
     return v;
   }

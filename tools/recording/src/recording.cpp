@@ -34,36 +34,6 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-// Parses a whole cell as a finite double; false for anything else.
-bool parse_number(std::string_view cell, double& out, bool& not_finite) {
-  not_finite = false;
-  cell = trim(cell);
-  if (cell.empty()) return false;
-  if (cell.front() == '+') {
-    cell.remove_prefix(1);
-    // from_chars takes a '-' of its own: "+-1" is two signs, not a number.
-    if (cell.empty() || cell.front() == '-') return false;
-  }
-  const auto r = std::from_chars(cell.data(), cell.data() + cell.size(), out);
-  if (r.ec != std::errc() || r.ptr != cell.data() + cell.size()) return false;
-  if (!std::isfinite(out)) {
-    not_finite = true;
-    return false;
-  }
-  return true;
-}
-
-// The value of a numeric metadata key, parsed as strictly as a data cell.
-double number_of(const std::string& key, const std::string& value) {
-  double v = 0.0;
-  bool not_finite = false;
-  if (!parse_number(value, v, not_finite)) {
-    throw std::invalid_argument("recording: metadata '" + key + "' is not a finite number: '" +
-                                value + "'");
-  }
-  return v;
-}
-
 std::vector<std::string_view> split_commas(std::string_view line) {
   std::vector<std::string_view> cells;
   std::size_t start = 0;
@@ -86,6 +56,39 @@ std::string read_file_bytes(const std::filesystem::path& path) {
   ss << in.rdbuf();
   if (in.bad()) throw RecordingError(name, 0, "", "read error");
   return ss.str();
+}
+
+}  // namespace
+
+bool parse_number(std::string_view cell, double& out, bool& not_finite) {
+  not_finite = false;
+  cell = trim(cell);
+  if (cell.empty()) return false;
+  if (cell.front() == '+') {
+    cell.remove_prefix(1);
+    // from_chars takes a '-' of its own: "+-1" is two signs, not a number.
+    if (cell.empty() || cell.front() == '-') return false;
+  }
+  const auto r = std::from_chars(cell.data(), cell.data() + cell.size(), out);
+  if (r.ec != std::errc() || r.ptr != cell.data() + cell.size()) return false;
+  if (!std::isfinite(out)) {
+    not_finite = true;
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The value of a numeric metadata key, parsed as strictly as a data cell.
+double number_of(const std::string& key, const std::string& value) {
+  double v = 0.0;
+  bool not_finite = false;
+  if (!parse_number(value, v, not_finite)) {
+    throw std::invalid_argument("recording: metadata '" + key + "' is not a finite number: '" +
+                                value + "'");
+  }
+  return v;
 }
 
 }  // namespace

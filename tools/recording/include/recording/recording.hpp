@@ -17,6 +17,12 @@ namespace detail {
 class RecordingParser;
 }
 
+// Parses a whole text (spaces and tabs around it aside) as a finite double,
+// the one rule for every number of a recording, cells and header alike: an
+// optional '+' or '-', no other text; false for anything else, with
+// `not_finite` set for an infinity or a NaN.
+bool parse_number(std::string_view text, double& out, bool& not_finite);
+
 // A malformed recording. `line` is 1-based (0 when the problem is not on one
 // line, e.g. a missing metadata key); `column` is the column name when the
 // problem is in one cell or column, empty otherwise. what() says all of it.
