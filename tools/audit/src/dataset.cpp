@@ -298,10 +298,12 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.ft_gx_per_s = (ge - gs).real() / (te - ts);
   f.ft_gy_per_s = (ge - gs).imag() / (te - ts);
   double c4 = 0, s4 = 0, v2 = 0, v2c4 = 0, v2s4 = 0, aa = 0, tc = 0, rr = 0;
+  cplx h;
   for (std::size_t i = q0; i <= q1; ++i) {
     const double ci = std::cos(4.0 * r.theta[i]), si = std::sin(4.0 * r.theta[i]);
     const double vi = r.pump ? (*r.pump)[i] * (*r.pump)[i] : 0.0;
     c4 += ci, s4 += si, v2 += vi, v2c4 += vi * ci, v2s4 += vi * si;
+    h += pump_per_amplitude(r, i) * vi;
     aa += r.a2[i];
     tc += r.temp ? (*r.temp)[i] : 0.0;
     rr += r.rate_rad_s(i);
@@ -309,6 +311,7 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   const auto m = static_cast<double>(best_len);
   f.mean_c4 = c4 / m, f.mean_s4 = s4 / m, f.mean_v2 = v2 / m, f.mean_a2 = aa / m;
   f.mean_v2c4 = v2c4 / m, f.mean_v2s4 = v2s4 / m;
+  f.ft_hx_v2 = h.real() / m, f.ft_hy_v2 = h.imag() / m;
   f.dlna_per_s = (le - ls) / (te - ts);
   f.mean_temp_c = tc / m, f.mean_rate_rad_s = rr / m;
   f.theta0_rad = r.theta[q0];

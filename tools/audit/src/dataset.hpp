@@ -71,6 +71,11 @@ struct ForcedSegment {
   // feedthrough's in-phase part turns the measured theta by
   // (Re(c_y) g_x - Re(c_x) g_y) / 2, so the drift by that of these.
   double ft_ax_per_s = 0.0, ft_ay_per_s = 0.0;
+  // Mean over the segment of (pump_v / a_A) e^{2 i theta} pump_v^2, V^2: the
+  // pump's phase follows the measured wave, which a feedthrough turns off the
+  // true one, and a pump off the wave pulls the true frequency in proportion
+  // to its drive (pump_phase_pull, model.hpp).
+  double ft_hx_v2 = 0.0, ft_hy_v2 = 0.0;
 };
 
 // A switching of exc between a free-decay segment and an excitation segment.

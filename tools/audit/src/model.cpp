@@ -207,6 +207,12 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
   return r;
 }
 
+double pump_phase_pull(const ForcedSegment& f, const std::array<double, 4>& c, double nu_per_s) {
+  if (!(f.mean_v2 > 0.0)) return 0.0;
+  const double growth_per_v2 = (f.dlna_per_s + nu_per_s) / f.mean_v2;
+  return 2.0 * growth_per_v2 * (c[1] * f.ft_hx_v2 + c[3] * f.ft_hy_v2);
+}
+
 namespace {
 // Pattern angle and amplitude the pickoff map shows for a standing wave of
 // unit amplitude at theta.

@@ -84,6 +84,15 @@ void evaluate(const Dataset& d, const Params& p, const EvalOptions& o, std::vect
 // Frequency residuals (rad/s) of the excitation segments alone.
 std::vector<double> forced_residuals(const Dataset& d, const Params& p);
 
+// The pull of a drive feedthrough c (Re, Im of c_x, c_y in the frame of the
+// wave phase) on the true frequency of excitation segment f, rad/s: the pump
+// follows the measured wave phase, which the feedthrough turns by delta =
+// Im(V (c_x cos 2 theta + c_y sin 2 theta)) / a_A off the true one, so its
+// parametric drive at twice the phase is 2 delta off and pulls the frequency
+// by G sin 2 delta ~ 2 delta G, G the pump's share of the growth, (a_A'/a_A +
+// nu) V^2 / mean V^2 (physics.md section 4; tools/audit/README.md step 2).
+double pump_phase_pull(const ForcedSegment& f, const std::array<double, 4>& c, double nu_per_s);
+
 // Amplitude balance of the excitation segments (1/s): the AGC holds a_A, so
 //   ln a_A(t1) - ln a_A(t0) + int s (nu + dnu_C c4 + dnu_S s4) dt
 //     = c int V^2 (1 + eps_p/2 c4 + eps_q/2 s4) dt
