@@ -763,7 +763,7 @@ void Auditor::remove_balance_pull(const std::vector<std::size_t>& use, AuditResu
 
 // Weight of the pattern-angle drift of the same segments, the same way: the
 // scatter beyond the white noise once the gap's shapes (c V^2 cos/sin 4
-// theta) and an error of K (the mean rate) are taken out, as e / T over the
+// theta) and an error of K (the rate over the span) are taken out, as e / T over the
 // end rows' span T, e from the fit weighted by T, with a floor of
 // kAngleFloor rad. No segment weighs more than one of the median length
 // (e / min(T, T_median)): e / T alone gave one long segment of the
@@ -782,7 +782,7 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
     const auto& f = d_.forced[use[k]];
     const auto row = static_cast<Eigen::Index>(k);
     const double t = f.angle_span_s;
-    h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.mean_rate_rad_s;
+    h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.angle_rate_rad_s;
     y(row) = t * r[k];
     se2 += t * t * f.angle_se_rad_s * f.angle_se_rad_s / static_cast<double>(n);
     spans.push_back(t);
