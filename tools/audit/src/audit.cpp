@@ -791,7 +791,10 @@ void Auditor::remove_balance_pull(const std::vector<std::size_t>& use, AuditResu
 
 // Weight of the pattern-angle drift of the same segments, the same way: the
 // scatter beyond the white noise once the gap's shapes (c V^2 cos/sin 4
-// theta) and an error of K (the mean rate) are taken out, as e / T over the
+// theta), an error of K (the rate over the span) and the shapes a pickoff
+// gain or misalignment leaves beside the baseline are taken out (before, on
+// the firmware's telemetry a gain of 3.6e-4 raised e from 1e-6 to 1.5e-5 rad
+// and hid itself: found 2.57e-4 +- 5.6e-5, not a finding), as e / T over the
 // end rows' span T, e from the fit weighted by T, with a floor of
 // kAngleFloor rad. No segment weighs more than one of the median length
 // (e / min(T, T_median)): e / T alone gave one long segment of the
@@ -802,7 +805,7 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
     d_.forced[i].angle_sigma_rad_s = 1.0;  // marks the segments angle_residuals() takes
   const std::vector<double> r = angle_residuals(d_, start_balance_);
   const std::size_t n = use.size();
-  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 3);
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 7);
   Eigen::VectorXd y(static_cast<Eigen::Index>(n));
   std::vector<double> spans;
   double se2 = 0.0;
@@ -810,14 +813,25 @@ void Auditor::weight_angle(const std::vector<std::size_t>& use) {
     const auto& f = d_.forced[use[k]];
     const auto row = static_cast<Eigen::Index>(k);
     const double t = f.angle_span_s;
-    h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.mean_rate_rad_s;
+    h(row, 0) = t * f.mean_v2c4, h(row, 1) = t * f.mean_v2s4, h(row, 2) = t * f.angle_rate_rad_s;
+    // A pickoff gain g (misalignment b) reads the angle as theta + g/4 sin
+    // 4theta (+ b/2 cos 4theta); free decays at one pattern rate r0 cannot
+    // tell that from a damping anisotropy dnu_S = -2 g r0 (dnu_C = -4 b r0),
+    // so the baseline takes it up, and its drift then acts on every segment,
+    // a still one too. These shapes are fitted as the gap's are, so that what
+    // a pickoff candidate explains is not counted as noise.
+    h(row, 3) = t * f.mean_c4, h(row, 4) = t * f.mean_s4;
+    h(row, 5) = std::sin(4.0 * f.theta1_rad) - std::sin(4.0 * f.theta0_rad);
+    h(row, 6) = std::cos(4.0 * f.theta1_rad) - std::cos(4.0 * f.theta0_rad);
     y(row) = t * r[k];
     se2 += t * t * f.angle_se_rad_s * f.angle_se_rad_s / static_cast<double>(n);
     spans.push_back(t);
   }
-  const Eigen::VectorXd coef = h.colPivHouseholderQr().solve(y);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(h);
+  const Eigen::VectorXd coef = qr.solve(y);
   const double rss = (y - h * coef).squaredNorm();
-  const double e2 = std::max(kAngleFloor * kAngleFloor, rss / static_cast<double>(n - 3) - se2);
+  const auto dof = static_cast<double>(n) - static_cast<double>(qr.rank());
+  const double e2 = std::max(kAngleFloor * kAngleFloor, rss / std::max(1.0, dof) - se2);
   auto mid = spans.begin() + static_cast<std::ptrdiff_t>(n / 2);
   std::nth_element(spans.begin(), mid, spans.end());
   const double t_median = *mid;

@@ -317,6 +317,10 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   f.theta0_rad = r.theta[q0];
   f.theta1_rad = r.theta[q1];
   f.angle_span_s = r.t[q1] - r.t[q0];
+  double rate_integral = 0.0;
+  for (std::size_t i = q0; i < q1; ++i)
+    rate_integral += 0.5 * (r.rate_rad_s(i) + r.rate_rad_s(i + 1)) * (r.t[i + 1] - r.t[i]);
+  f.angle_rate_rad_s = rate_integral / f.angle_span_s;
   const cplx dg = pump_per_amplitude(r, q1) - pump_per_amplitude(r, q0);
   f.ft_ax_per_s = dg.real() / f.angle_span_s;
   f.ft_ay_per_s = dg.imag() / f.angle_span_s;

@@ -291,7 +291,7 @@ std::vector<double> angle_residuals(const Dataset& d, const Params& p) {
     const double readout = (measured_theta(p, f.theta1_rad) - f.theta1_rad) -
                            (measured_theta(p, f.theta0_rad) - f.theta0_rad);
     r.push_back((f.theta1_rad - f.theta0_rad - readout) / t - f.angle_pull_rad_s -
-                0.5 * (drift - p[kK] * f.mean_rate_rad_s));
+                0.5 * (drift - p[kK] * f.angle_rate_rad_s));
   }
   return r;
 }

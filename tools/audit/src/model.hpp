@@ -116,7 +116,7 @@ PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<
 // Pattern-angle drift of the same segments (rad/s): measured
 // (theta1 - theta0) / angle_span_s (single end rows over their own span), less
 // a drive feedthrough's angle_pull_rad_s, against Omega K = -2 theta' + D
-// (physics.md) with
+// (physics.md; Omega the rate's integral over that span, angle_rate_rad_s) with
 //   D = s (dnu_C sin4th - dnu_S cos4th) + c V^2 (eps_q/2 cos4th - eps_p/2 sin4th)
 // (the damping anisotropy's drift and the pump's through the gap, c from the
 // balance) and the pickoff map's readout distortion at both ends. One per
