@@ -9,9 +9,11 @@ HRG_CAL_READINGS); `hrg audit REC --calibration OUT.toml` on both writes the
 same feedthrough, combined with the switch-off step check's reading, within
 what that resolution moves it.
 
-usage: readings.py HRG SCENARIO CALIBRATION DURATION_S WORKDIR [--keys-only]
+usage: readings.py HRG SCENARIO CALIBRATION|- DURATION_S WORKDIR [--keys-only] [--thermal]
+CALIBRATION '-': none in force.
 --keys-only: the keys alone (a calibration that removes the feedthrough
 leaves the audit nothing to find, and the file nothing to combine).
+--thermal: the run must have the damping model check's thermal reading.
 Exit status 0 when they agree; prints every key and value compared.
 """
 import os
@@ -63,10 +65,12 @@ def tolerance(key):
     raise SystemExit(f"no tolerance for {key}")
 
 
-def compare_keys(csv_keys, can_keys, bad):
+def compare_keys(csv_keys, can_keys, thermal, bad):
     wanted = sorted(k for k in csv_keys if k.startswith(("pump_edge_", "damping_check_")))
     if not any(k.startswith("pump_edge_") for k in wanted):
         bad.append("telemetry.csv has no pump_edge_* keys: the run measured no switch-off")
+    if thermal and "damping_check_thermal_damping_per_c" not in wanted:
+        bad.append("telemetry.csv has no damping_check_* keys: the run has no thermal reading")
     for k in wanted:
         if k not in can_keys:
             bad.append(f"{k} missing from the decoded recording")
@@ -126,20 +130,22 @@ def compare_files(csv_cal, can_cal, bad):
 
 
 def main():
-    keys_only = sys.argv[6:] == ["--keys-only"]
-    if len(sys.argv) != 6 + keys_only:
+    flags = sys.argv[6:]
+    keys_only, thermal = "--keys-only" in flags, "--thermal" in flags
+    if len(sys.argv) < 6 or len(flags) != keys_only + thermal:
         raise SystemExit(__doc__)
     hrg, scenario, cal, duration, work = sys.argv[1:6]
     os.makedirs(work, exist_ok=True)
     log = os.path.join(work, "run.log")
-    run([hrg, "sim", "--scenario", scenario, "--calibration", cal, "--duration", duration,
-         "--out", os.path.join(work, "sim"), "--can-log", log, "--no-plots", "--quiet"])
+    sim = [hrg, "sim", "--scenario", scenario, "--duration", duration,
+           "--out", os.path.join(work, "sim"), "--can-log", log, "--no-plots", "--quiet"]
+    run(sim + (["--calibration", cal] if cal != "-" else []))
     decoded = os.path.join(work, "can.csv")
     dec = run([hrg, "can-decode", log, "-o", decoded])
     sys.stdout.write(dec)
     csv = os.path.join(work, "sim", "telemetry.csv")
     bad = []
-    compare_keys(header(csv), header(decoded), bad)
+    compare_keys(header(csv), header(decoded), thermal, bad)
     files = (os.path.join(work, "csv.toml"), os.path.join(work, "can.toml"))
     if not keys_only:
         for rec, out in zip((csv, decoded), files):
