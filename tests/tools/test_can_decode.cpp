@@ -240,6 +240,7 @@ TEST(CanDecode, ASetWithALostPageIsNotUsedAndWithoutACompleteSetNoKeyIsWritten) 
   hrg::can::CanDecodeOptions o = options(log, "test_can_decode_partial.csv");
   hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
   LONGS_EQUAL(1, s.cal_readings_sets);
+  LONGS_EQUAL(1, s.cal_readings_dropped);
   hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
   LONGS_EQUAL(1, static_cast<long>(key(rec, "pump_edge_edges")));  // held at frame 86
   // GIVEN a page of each set lost: no complete set, no key, nothing guessed

@@ -275,6 +275,10 @@ void print_summary(const CanDecodeOptions& o, const CanDecodeSummary& s) {
         "can-decode: no complete HRG_CAL_READINGS set: no pump_edge_* or damping_check_* "
         "keys\n");
   }
+  if (s.cal_readings_dropped > 0) {
+    std::printf("can-decode: %llu HRG_CAL_READINGS sets with a page lost or out of turn not used\n",
+                static_cast<unsigned long long>(s.cal_readings_dropped));
+  }
   if (s.unpaired_wave > 0) {
     std::printf("can-decode: %llu wave frames without their pair (no row)\n",
                 static_cast<unsigned long long>(s.unpaired_wave));
