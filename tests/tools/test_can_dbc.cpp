@@ -48,6 +48,9 @@ void check_message(const MessageDef& m, const hrg::can::Dbc& d) {
     DOUBLES_EQUAL(s.min, ds->min, 1e-9 * (1 + std::fabs(s.min)));
     DOUBLES_EQUAL(s.max, ds->max, 1e-9 * (1 + std::fabs(s.max)));
     STRCMP_EQUAL(s.unit, ds->unit.c_str());
+    CHECK_EQUAL(s.mux == MuxRole::multiplexor, ds->multiplexor);
+    CHECK_EQUAL(s.mux == MuxRole::multiplexed, ds->mux_value.has_value());
+    if (ds->mux_value) LONGS_EQUAL(s.mux_value, *ds->mux_value);
   }
   if (m.default_rate_hz != 0) {
     CHECK_TEXT(dm->cycle_time_ms.has_value(), m.name);
@@ -147,6 +150,36 @@ TEST(DbcAgreesWithCode, FramesEncodedByTheFirmwareDecodeThroughTheDbc) {
   s.f_ref_hz = 4999.87312;
   encode_telemetry(Tm::reference, s, 9, f);
   DOUBLES_EQUAL(4999.87312, dbc().message(f.id)->signal("f_ref_hz")->decode(f), 1e-9);
+  // HRG_CAL_READINGS: each page's signals through the DBC, present only on
+  // their page.
+  s.estimates.feedthrough = true;
+  s.estimates.edges = 34;
+  s.estimates.in_force_s = 1799.99;
+  s.estimates.feedthrough_residual_v_per_v = {4.019e-4, 6.925e-4, 6.932e-4, -4.025e-4};
+  s.estimates.feedthrough_sigma_v_per_v = 2.7e-6;
+  s.estimates.feedthrough_in_force_v_per_v = {0.1, -0.1, 0, 3.998e-4};
+  s.estimates.thermal_damping = true;
+  s.estimates.thermal_damping_per_c = 0.2;
+  s.estimates.thermal_damping_sigma_per_c = 1.5e-4;
+  const auto* readings = dbc().message("HRG_CAL_READINGS");
+  CHECK(readings != nullptr);
+  const auto at = [&](uint8_t page, const char* name) {
+    encode_cal_readings(s.estimates, page, 5, f);
+    const auto* sig = readings->signal(name);
+    CHECK_TEXT(readings->present(*sig, f), name);
+    return sig->decode(f);
+  };
+  DOUBLES_EQUAL(34, at(0, "pump_edge_edges"), 0);
+  DOUBLES_EQUAL(1799.99, at(0, "pump_edge_in_force_s"), 1e-9);
+  DOUBLES_EQUAL(6.932e-4, at(2, "pump_edge_y_re_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(2.7e-6, at(3, "pump_edge_sigma_v_per_v"), 5e-10);
+  DOUBLES_EQUAL(-0.1, at(4, "pump_edge_in_force_x_im_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(3.998e-4, at(5, "pump_edge_in_force_y_im_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(0.2, at(6, "thermal_damping_per_c"), 5e-8);
+  DOUBLES_EQUAL(1, at(6, "thermal_valid"), 0);
+  encode_cal_readings(s.estimates, 1, 5, f);
+  CHECK_FALSE(readings->present(*readings->signal("pump_edge_edges"), f));
+  CHECK(readings->present(*readings->signal("seq"), f));
   f = encode_lab_table(-123.456789, 31.27, 3);
   DOUBLES_EQUAL(-123.456789, dbc().message(f.id)->signal("rate_dps")->decode(f), 1e-12);
   DOUBLES_EQUAL(31.27, dbc().message(f.id)->signal("temp_c")->decode(f), 1e-9);
@@ -191,6 +224,50 @@ TEST(DbcParser, AMalformedSignalIsReportedWithItsLine) {
   } catch (const hrg::can::DbcError& e) {
     STRCMP_CONTAINS("u.dbc:1:", e.what());
   }
+}
+
+TEST(DbcParser, MultiplexedSignalsAreReadWithTheirPage) {
+  const auto d = hrg::can::parse_dbc(
+      "BO_ 270 R: 8 HRG\n"
+      " SG_ a m1 : 8|8@1+ (1,0) [0|255] \"\" HOST\n"
+      " SG_ page M : 0|4@1+ (1,0) [0|6] \"\" HOST\n"
+      " SG_ b m0 : 8|16@1- (0.5,0) [-16384|16383.5] \"\" HOST\n");
+  const auto* m = d.message(270u);
+  CHECK(m->multiplexor() == m->signal("page"));
+  LONGS_EQUAL(1, *m->signal("a")->mux_value);
+  LONGS_EQUAL(0, *m->signal("b")->mux_value);
+  CHECK_FALSE(m->signal("page")->mux_value.has_value());
+  hrg::hal::CanFrame f;
+  f.data[0] = 1;
+  f.data[1] = 42;
+  CHECK(m->present(*m->signal("a"), f));
+  CHECK_FALSE(m->present(*m->signal("b"), f));
+  DOUBLES_EQUAL(42, m->signal("a")->decode(f), 0);
+}
+
+TEST(DbcParser, BadMultiplexingIsReportedWithItsLine) {
+  const auto error = [](const char* text) {
+    try {
+      hrg::can::parse_dbc(text, "m.dbc");
+    } catch (const hrg::can::DbcError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // a page with no multiplexor in the message
+  std::string e = error("BO_ 1 A: 8 HRG\n SG_ x m2 : 8|8@1+ (1,0) [0|255] \"\" HOST\n");
+  STRCMP_CONTAINS("m.dbc:2:", e.c_str());
+  STRCMP_CONTAINS("no multiplexor", e.c_str());
+  // extended multiplexing (a multiplexed multiplexor)
+  e = error("BO_ 1 A: 8 HRG\n SG_ x m2M : 8|8@1+ (1,0) [0|255] \"\" HOST\n");
+  STRCMP_CONTAINS("m.dbc:2:", e.c_str());
+  STRCMP_CONTAINS("extended multiplexing", e.c_str());
+  // two multiplexors
+  e = error(
+      "BO_ 1 A: 8 HRG\n SG_ x M : 0|4@1+ (1,0) [0|15] \"\" HOST\n"
+      " SG_ y M : 4|4@1+ (1,0) [0|15] \"\" HOST\n");
+  STRCMP_CONTAINS("m.dbc:3:", e.c_str());
+  STRCMP_CONTAINS("second multiplexor", e.c_str());
 }
 
 TEST(DbcParser, ExtendedIdentifiersAndCycleTimesAreRead) {

@@ -10,6 +10,7 @@
 
 #include "can/can_decode.hpp"
 #include "can/candump_log.hpp"
+#include "firmware/can/messages.hpp"
 #include "firmware/can/telemetry.hpp"
 #include "recording/recording.hpp"
 
@@ -38,6 +39,18 @@ TelemetrySnapshot sample(int k) {
   s.pll_freq_hz = 4999.87310 + 1e-4 * k;
   s.angular_gain = 0.554;
   s.mode = hrg::fw::Mode::operate;
+  // The firmware's readings: one more edge every 100 ms.
+  FirmwareEstimates& e = s.estimates;
+  e.feedthrough = true;
+  e.edges = 1 + static_cast<uint32_t>(k / 100);
+  e.in_force_s = 1e-3 * k;
+  e.feedthrough_residual_v_per_v = {4e-4 + 1e-7 * k, 6.9e-4, 6.9e-4, -4e-4};
+  e.feedthrough_in_force_v_per_v = {1e-5, 0, 0, -2e-5};
+  e.feedthrough_sigma_v_per_v = 2.7e-6;
+  e.feedthrough_scatter_v_per_v = 1.7e-6;
+  e.thermal_damping = true;
+  e.thermal_damping_per_c = 0.0039;
+  e.thermal_damping_sigma_per_c = 1.5e-4;
   return s;
 }
 
@@ -182,4 +195,122 @@ TEST(CanDecode, ALogWithoutTheAngularGainIsRefusedUnlessItIsGiven) {
   LONGS_EQUAL(200, hrg::can::can_decode(o).rows);
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
+}
+
+namespace {
+
+double key(const hrg::recording::Recording& rec, const char* k) {
+  const std::string v = rec.metadata_value(k);
+  CHECK_TEXT(!v.empty(), k);
+  return std::stod(v);
+}
+
+}  // namespace
+
+TEST(CanDecode, TheLastCompleteSetOfTheFirmwareReadingsBecomesTheHeaderKeys) {
+  // GIVEN two seconds of telemetry: HRG_CAL_READINGS sets start at frames
+  // 86, 786 and 1486 (10 Hz, 7 pages); the third has 6 pages when the log ends
+  const std::string log = write_log({});
+  const hrg::can::CanDecodeOptions o = options(log, "test_can_decode_readings.csv");
+  // WHEN it is decoded
+  const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
+  // THEN the keys are the second set's, held at its first page (frame 786)
+  LONGS_EQUAL(2, s.cal_readings_sets);
+  const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
+  const TelemetrySnapshot at = sample(786);
+  LONGS_EQUAL(8, static_cast<long>(key(rec, "pump_edge_edges")));
+  DOUBLES_EQUAL(at.estimates.in_force_s, key(rec, "pump_edge_in_force_s"), 0.005);
+  DOUBLES_EQUAL(at.estimates.feedthrough_residual_v_per_v.x_re, key(rec, "pump_edge_x_re_v_per_v"),
+                1e-8);
+  DOUBLES_EQUAL(-4e-4, key(rec, "pump_edge_y_im_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(2.7e-6, key(rec, "pump_edge_sigma_v_per_v"), 5e-10);
+  DOUBLES_EQUAL(1.7e-6, key(rec, "pump_edge_scatter_v_per_v"), 5e-10);
+  DOUBLES_EQUAL(1e-5, key(rec, "pump_edge_in_force_x_re_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(-2e-5, key(rec, "pump_edge_in_force_y_im_v_per_v"), 1e-8);
+  DOUBLES_EQUAL(0.0039, key(rec, "damping_check_thermal_damping_per_c"), 5e-8);
+  DOUBLES_EQUAL(1.5e-4, key(rec, "damping_check_thermal_damping_sigma_per_c"), 5e-9);
+  std::remove(log.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(CanDecode, ASetWithALostPageIsNotUsedAndWithoutACompleteSetNoKeyIsWritten) {
+  const int rd = static_cast<int>(Tm::cal_readings);
+  // GIVEN the second set's page 2 lost: the first set is the last complete one
+  std::string log = write_log({{rd, 9}});
+  hrg::can::CanDecodeOptions o = options(log, "test_can_decode_partial.csv");
+  hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
+  LONGS_EQUAL(1, s.cal_readings_sets);
+  LONGS_EQUAL(1, s.cal_readings_dropped);
+  hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
+  LONGS_EQUAL(1, static_cast<long>(key(rec, "pump_edge_edges")));  // held at frame 86
+  // GIVEN a page of each set lost: no complete set, no key, nothing guessed
+  log = write_log({{rd, 3}, {rd, 9}});
+  s = hrg::can::can_decode(o);
+  LONGS_EQUAL(0, s.cal_readings_sets);
+  CHECK_FALSE(s.estimates.has_value());
+  rec = hrg::recording::read_recording(o.out_path);
+  for (const char* k : {"pump_edge_edges", "pump_edge_x_re_v_per_v", "pump_edge_in_force_s",
+                        "damping_check_thermal_damping_per_c"}) {
+    CHECK_TEXT(rec.metadata_value(k).empty(), k);
+  }
+  std::remove(log.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(CanDecode, WithoutAFeedthroughOrThermalReadingTheirKeysAreLeftOut) {
+  // GIVEN a set sent with no edge and no thermal reading
+  const std::string path = "test_can_decode_none.log";
+  {
+    hrg::can::CandumpLogWriter w(path);
+    TelemetrySnapshot s = sample(0);
+    w.write(encode_lab_table(0, 25, 0), kT0Ns);
+    hrg::hal::CanFrame f;
+    encode_telemetry(Tm::info, s, 0, f);
+    w.write(f, kT0Ns + 1);
+    encode_telemetry(Tm::reference, s, 0, f);
+    w.write(f, kT0Ns + 2);
+    for (uint8_t page = 0; page < kCalReadingsPages; ++page) {
+      encode_cal_readings(FirmwareEstimates{}, page, page, f);
+      w.write(f, kT0Ns + 100'000'000ull * (page + 1));
+      // ... beside rows (a recording has some)
+      const TelemetrySnapshot row = sample(10 * page);
+      for (const Tm m : {Tm::wave_x, Tm::wave_y, Tm::row}) {
+        encode_telemetry(m, row, page, f);
+        w.write(f, kT0Ns + 100'000'000ull * (page + 1) + 10);
+      }
+    }
+  }
+  hrg::can::CanDecodeOptions o = options(path, "test_can_decode_none.csv");
+  const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
+  // THEN the set is read, and says there is nothing to write
+  LONGS_EQUAL(1, s.cal_readings_sets);
+  const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
+  CHECK_TRUE(rec.metadata_value("pump_edge_edges").empty());
+  CHECK_TRUE(rec.metadata_value("damping_check_thermal_damping_per_c").empty());
+  std::remove(path.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(CanDecode, AReadingOutsideItsRangeIsRefusedNamingTheMessageTheSignalAndTheLine) {
+  // GIVEN a log whose third line is HRG_CAL_READINGS with page 9 (the DBC's 0-6)
+  const std::string path = "test_can_decode_bad.log";
+  {
+    hrg::can::CandumpLogWriter w(path);
+    hrg::hal::CanFrame f;
+    encode_cal_readings(FirmwareEstimates{}, 0, 0, f);
+    w.write(f, kT0Ns);
+    encode_cal_readings(FirmwareEstimates{}, 1, 1, f);
+    w.write(f, kT0Ns + 1);
+    f.data[0] = static_cast<uint8_t>((f.data[0] & 0xF0u) | 9u);
+    w.write(f, kT0Ns + 2);
+  }
+  try {
+    hrg::can::can_decode(options(path, "test_can_decode_bad.csv"));
+    FAIL("decoded a page out of range");
+  } catch (const std::runtime_error& e) {
+    STRCMP_CONTAINS("test_can_decode_bad.log:3:", e.what());
+    STRCMP_CONTAINS("HRG_CAL_READINGS signal 'page' = 9", e.what());
+    STRCMP_CONTAINS("outside its range [0, 6]", e.what());
+  }
+  std::remove(path.c_str());
 }

@@ -8,8 +8,10 @@
 #include <string_view>
 #include <vector>
 
+#include "can/cal_readings.hpp"
 #include "can/candump_log.hpp"
 #include "can/dbc.hpp"
+#include "can/estimates_header.hpp"
 #include "firmware/can/signal.hpp"
 #include "recording/recording_writer.hpp"
 
@@ -27,6 +29,7 @@ struct Layout {
   const DbcMessage* status;
   const DbcMessage* info;
   const DbcMessage* lab_table;
+  const DbcMessage* cal_readings;  // nullptr in a DBC before protocol 3
 };
 
 const DbcMessage& need(const Dbc& dbc, std::string_view name, const std::string& path) {
@@ -50,7 +53,7 @@ void for_each_frame(const std::string& path, Fn fn) {
   LoggedFrame lf;
   try {
     while (reader.next(lf))
-      fn(lf);
+      fn(lf, reader.line_number());
   } catch (const CandumpError& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
@@ -82,7 +85,8 @@ void scan_log(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L, CanDec
   std::map<uint32_t, int> last_seq;
   std::optional<double> k = o.angular_gain;
   std::optional<double> f_ref = o.f_ref_hz;
-  for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
+  CalReadingsReader readings;
+  for_each_frame(o.log_path, [&](const LoggedFrame& lf, std::size_t line) {
     if (sum.frames++ == 0) sum.t0_s = static_cast<double>(lf.t_ns) * 1e-9;
     sum.span_s = static_cast<double>(lf.t_ns) * 1e-9 - sum.t0_s;
     if (!lf.error_frame) sum.bus_bits += fw::can::worst_case_frame_bits(lf.frame.len);
@@ -95,7 +99,11 @@ void scan_log(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L, CanDec
     if (m == L.info && !k) k = value(*m, "angular_gain", lf.frame);
     if (m == L.reference && !f_ref) f_ref = value(*m, "f_ref_hz", lf.frame);
     if (m == L.lab_table) sum.has_lab_table = true;
+    if (m == L.cal_readings) readings.add(*m, lf.frame, o.log_path + ":" + std::to_string(line));
   });
+  sum.estimates = readings.last();
+  sum.cal_readings_sets = readings.complete_sets();
+  sum.cal_readings_dropped = readings.dropped_sets();
   if (!k)
     throw std::runtime_error(o.log_path +
                              ": no HRG_INFO frame gives angular_gain; pass --angular-gain");
@@ -120,6 +128,12 @@ std::vector<std::pair<std::string, std::string>> recording_metadata(const CanDec
   for (const auto& [name, ml] : sum.messages) {
     meta.emplace_back("can_lost_" + name,
                       std::to_string(ml.lost) + " of " + std::to_string(ml.frames + ml.lost));
+  }
+  // The firmware's own readings for hrg audit --calibration, from the last
+  // complete set of HRG_CAL_READINGS: the keys hrg sim writes.
+  if (sum.estimates) {
+    for (auto& kv : estimates_header(*sum.estimates))
+      meta.push_back(std::move(kv));
   }
   return meta;
 }
@@ -182,7 +196,7 @@ void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
   PendingRow p;
   Latest v;
   double last_t = -1;
-  for_each_frame(o.log_path, [&](const LoggedFrame& lf) {
+  for_each_frame(o.log_path, [&](const LoggedFrame& lf, std::size_t) {
     const DbcMessage* m = known_message(dbc, lf);
     if (m == nullptr) return;
     const hal::CanFrame& f = lf.frame;
@@ -212,7 +226,8 @@ CanDecodeSummary can_decode(const CanDecodeOptions& o) {
   const Layout L{&need(dbc, "HRG_WAVE_X", dbc_path), &need(dbc, "HRG_WAVE_Y", dbc_path),
                  &need(dbc, "HRG_ROW", dbc_path),    &need(dbc, "HRG_REFERENCE", dbc_path),
                  &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_STATUS", dbc_path),
-                 &need(dbc, "HRG_INFO", dbc_path),   dbc.message("LAB_TABLE")};
+                 &need(dbc, "HRG_INFO", dbc_path),   dbc.message("LAB_TABLE"),
+                 dbc.message("HRG_CAL_READINGS")};
   CanDecodeSummary sum;
   sum.bitrate_bps = dbc.bitrate_bps;
   scan_log(o, dbc, L, sum);
@@ -248,6 +263,22 @@ void print_summary(const CanDecodeOptions& o, const CanDecodeSummary& s) {
         "over %.1f s)\n",
         100.0 * bps / s.bitrate_bps, s.bitrate_bps, bps, s.span_s);
   }
+  if (s.estimates) {
+    std::printf(
+        "can-decode: firmware readings from the last of %llu complete HRG_CAL_READINGS "
+        "sets (%s%s)\n",
+        static_cast<unsigned long long>(s.cal_readings_sets),
+        s.estimates->feedthrough ? "pump_edge_*" : "no edge",
+        s.estimates->thermal_damping ? ", damping_check_*" : "");
+  } else {
+    std::printf(
+        "can-decode: no complete HRG_CAL_READINGS set: no pump_edge_* or damping_check_* "
+        "keys\n");
+  }
+  if (s.cal_readings_dropped > 0) {
+    std::printf("can-decode: %llu HRG_CAL_READINGS sets with a page lost or out of turn not used\n",
+                static_cast<unsigned long long>(s.cal_readings_dropped));
+  }
   if (s.unpaired_wave > 0) {
     std::printf("can-decode: %llu wave frames without their pair (no row)\n",
                 static_cast<unsigned long long>(s.unpaired_wave));
@@ -261,14 +292,14 @@ void print_summary(const CanDecodeOptions& o, const CanDecodeSummary& s) {
 int can_decode_main(std::span<char* const> args) {
   CanDecodeOptions o;
   auto usage = [] {
-    std::fprintf(
-        stderr,
-        "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
-        "[--f-ref-hz F]\n"
-        "Turns a candump -l log of HRG telemetry (protocol 2) into an hrg-recording v1\n"
-        "that hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s,\n"
-        "the drive as applied, rate and temperature from the bench's LAB_TABLE), and\n"
-        "reports the frames lost (from each message's sequence counter) and the bus load.\n");
+    std::fprintf(stderr,
+                 "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
+                 "[--f-ref-hz F]\n"
+                 "Turns a candump -l log of HRG telemetry (protocol 2 or 3) into an hrg-recording\n"
+                 "v1 that hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s,\n"
+                 "the drive as applied, rate and temperature from the bench's LAB_TABLE, the\n"
+                 "firmware's readings of HRG_CAL_READINGS as header keys), and reports the\n"
+                 "frames lost (from each message's sequence counter) and the bus load.\n");
     return 2;
   };
   for (std::size_t i = 0; i < args.size(); ++i) {

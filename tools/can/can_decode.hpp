@@ -7,6 +7,8 @@
 #include <span>
 #include <string>
 
+#include "firmware/can/firmware_estimates.hpp"
+
 namespace hrg::can {
 
 struct CanDecodeOptions {
@@ -33,6 +35,12 @@ struct CanDecodeSummary {
   double angular_gain = 0;
   double t0_s = 0;             // log time of the first frame
   bool has_lab_table = false;  // LAB_TABLE frames give rate_dps and temp_c
+  // The firmware's readings from the last complete HRG_CAL_READINGS set
+  // (none: no such set in the log), the complete sets and those dropped
+  // for a lost or out-of-turn page.
+  std::optional<fw::can::FirmwareEstimates> estimates;
+  uint64_t cal_readings_sets = 0;
+  uint64_t cal_readings_dropped = 0;
   // Bus load of the log: every frame at its worst-case stuffed length
   // (11-bit identifiers; error frames left out) over the span of the log.
   double bus_bits = 0;
@@ -47,9 +55,12 @@ struct CanDecodeSummary {
 // the same block; rate_dps and temp_c from the latest LAB_TABLE when the log
 // has any (else temp_c from HRG_STATUS and no rate); mode, exc_cmd (the
 // excitation command) and pll_hz the latest values. Losses are counted per
-// message from the sequence counters and written to the metadata. Throws
-// std::runtime_error (naming file and line) on unreadable input or when K or
-// the reference frequency is unknown.
+// message from the sequence counters and written to the metadata. The
+// firmware's own readings (HRG_CAL_READINGS, last complete set) become the
+// header keys hrg sim writes (can/estimates_header.hpp); none without a
+// complete set. Throws std::runtime_error (naming file and line) on
+// unreadable input, a reading outside its DBC range, or when K or the
+// reference frequency is unknown.
 CanDecodeSummary can_decode(const CanDecodeOptions& options);
 
 // `hrg can-decode LOG -o REC.csv [--dbc FILE] [--angular-gain K] [--f-ref-hz F]`.

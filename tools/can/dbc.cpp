@@ -64,6 +64,7 @@ class Tokens {
     return v;
   }
   [[noreturn]] void fail(const std::string& what) const { throw DbcError(src_, line_, what); }
+  std::size_t line() const { return line_; }
 
  private:
   static bool is_word(char c) {
@@ -83,9 +84,24 @@ class Tokens {
 
 void parse_signal(Tokens& t, DbcMessage& m) {
   DbcSignal s;
+  s.line = t.line();
   s.name = t.next();
   std::string tok = t.next();
-  if (tok != ":") t.fail("multiplexed signal '" + s.name + "' is not supported");
+  // Simple multiplexing: "M" the multiplexor, "mN" a signal of page N.
+  if (tok == "M") {
+    s.multiplexor = true;
+    tok = t.next();
+  } else if (tok.size() > 1 && tok[0] == 'm') {
+    unsigned page = 0;
+    const auto r = std::from_chars(tok.data() + 1, tok.data() + tok.size(), page);
+    if (r.ec != std::errc() || r.ptr != tok.data() + tok.size()) {
+      t.fail("signal '" + s.name + "': '" + tok +
+             "' is not a multiplex indicator (M or mN; extended multiplexing is not supported)");
+    }
+    s.mux_value = page;
+    tok = t.next();
+  }
+  if (tok != ":") t.fail("signal '" + s.name + "': expected ':', found '" + tok + "'");
   // "0|24@1-": start, '|', length, '@', then byte order and sign as one word.
   const uint64_t start = t.integer();
   t.expect("|");
@@ -113,7 +129,24 @@ void parse_signal(Tokens& t, DbcMessage& m) {
   t.expect("]");
   s.unit = t.next();
   if (s.factor == 0) t.fail("signal '" + s.name + "' has a zero factor");
+  if (m.signal(s.name) != nullptr) t.fail("signal '" + s.name + "' defined twice");
+  if (s.multiplexor && m.multiplexor() != nullptr)
+    t.fail("message '" + m.name + "' has a second multiplexor '" + s.name + "'");
   m.signals.push_back(std::move(s));
+}
+
+// Every multiplexed signal needs its message's multiplexor.
+void check_multiplexing(const Dbc& dbc, const std::string& source) {
+  for (const auto& m : dbc.messages) {
+    if (m.multiplexor() != nullptr) continue;
+    for (const auto& s : m.signals) {
+      if (s.mux_value) {
+        throw DbcError(source, s.line,
+                       "signal '" + s.name + "' of message '" + m.name +
+                           "' is multiplexed but the message has no multiplexor (M)");
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -134,6 +167,18 @@ const DbcSignal* DbcMessage::signal(std::string_view n) const {
   for (const auto& s : signals)
     if (s.name == n) return &s;
   return nullptr;
+}
+
+const DbcSignal* DbcMessage::multiplexor() const {
+  for (const auto& s : signals)
+    if (s.multiplexor) return &s;
+  return nullptr;
+}
+
+bool DbcMessage::present(const DbcSignal& s, const hal::CanFrame& f) const {
+  if (!s.mux_value) return true;
+  const DbcSignal* mux = multiplexor();
+  return mux != nullptr && mux->decode_raw(f) == static_cast<int64_t>(*s.mux_value);
 }
 
 DbcError::DbcError(const std::string& source, std::size_t line, const std::string& what)
@@ -223,6 +268,7 @@ Dbc parse_dbc(std::string_view text, const std::string& source) {
     // A multi-line CM_ string would confuse the line-based reader: the
     // project's DBC keeps comments on one line.
   }
+  check_multiplexing(dbc, source);
   return dbc;
 }
 

@@ -14,8 +14,9 @@
 namespace hrg::can {
 
 // The parts of a DBC file the project uses: messages (BO_), signals (SG_, Intel
-// byte order, no multiplexing), cycle times (BA_ "GenMsgCycleTime") and value
-// tables (VAL_). Other sections are skipped.
+// byte order; simple multiplexing: one multiplexor `M` per message and
+// signals `mN` present when it reads N), cycle times (BA_ "GenMsgCycleTime")
+// and value tables (VAL_). Other sections are skipped.
 struct DbcSignal {
   std::string name;
   unsigned start_bit = 0;
@@ -27,6 +28,9 @@ struct DbcSignal {
   double max = 0;
   std::string unit;
   std::map<int64_t, std::string> values;  // VAL_ table
+  bool multiplexor = false;               // `M`: its raw value selects the page
+  std::optional<unsigned> mux_value;      // `mN`: present only on page N
+  std::size_t line = 0;                   // where the DBC defines it (1-based)
 
   int64_t decode_raw(const hal::CanFrame& f) const;
   double decode(const hal::CanFrame& f) const {
@@ -44,6 +48,11 @@ struct DbcMessage {
   std::optional<unsigned> cycle_time_ms;  // GenMsgCycleTime, absent for event messages
 
   const DbcSignal* signal(std::string_view name) const;
+  // The multiplexor signal, or nullptr (a plain message).
+  const DbcSignal* multiplexor() const;
+  // Whether `s` (one of this message's signals) is in frame `f`: always,
+  // unless it is multiplexed and the multiplexor reads another page.
+  bool present(const DbcSignal& s, const hal::CanFrame& f) const;
 };
 
 // Malformed DBC input; `line` is 1-based.

@@ -91,6 +91,27 @@ void Firmware::put_in_force(const Calibration& cal, bool electronics_changed) {
   if (electronics_changed) gyro_.restart_pump_edge_check();
 }
 
+can::FirmwareEstimates Firmware::estimates() const {
+  const PumpEdgeStatus& edges = gyro_.status().pump_edge;
+  const Calibration& in_force = cfg_.calibration;
+  can::FirmwareEstimates e;
+  if (edges.edges > 0) {
+    e.feedthrough = true;
+    e.edges = edges.edges;
+    e.feedthrough_residual_v_per_v =
+        residual_at_raw_pickoffs(in_force, {edges.x_re, edges.x_im, edges.y_re, edges.y_im});
+    e.feedthrough_in_force_v_per_v = feedthrough_coefficients(in_force);
+    e.feedthrough_sigma_v_per_v = edges.sigma_v_per_v;
+    e.feedthrough_scatter_v_per_v = edges.scatter_v_per_v;
+    e.in_force_s = edges.in_force_s;
+  }
+  const EstimatorPort::ThermalDampingReading thermal = estimator_.thermal_damping_reading();
+  e.thermal_damping = thermal.valid;
+  e.thermal_damping_per_c = thermal.per_c;
+  e.thermal_damping_sigma_per_c = thermal.sigma_per_c;
+  return e;
+}
+
 bool Firmware::checking() const {
   return gyro_.config().identify ? gyro_.scheduler().campaign_done() : estimator_.health().solved;
 }

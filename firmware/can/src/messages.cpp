@@ -107,6 +107,45 @@ constexpr SignalDef kReference[] = {
   {"f_ref_hz", 0, 32, false, 1e-5, 0, 0, 4294967295.0 * 1e-5, "Hz"},
   {"seq", 32, 8, false, 1, 0, 0, 255, ""},
 };
+// The firmware's own readings for a calibration file (FirmwareEstimates),
+// one page per frame after the multiplexor. Feedthrough parts: 2e-8 V/V
+// (1/50 of the check's sigma, ~1e-6), +-0.168 V/V (the calibration's range
+// is +-0.1); their sigmas 1e-9 V/V up to 0.0168 (a reading less precise
+// than that weighs nothing against the audit's); thermal damping 1e-7
+// /degC (1/1000 of its sigma, ~1e-4), +-0.839 (the calibration's +-0.2).
+constexpr double kFtFactor = 2e-8;
+constexpr double kSigmaFactor = 1e-9;
+constexpr double kU24 = 16777215.0;  // 2^24 - 1
+// A feedthrough part (signed, 24 bits) and a sigma (unsigned, 24 bits) of a page.
+constexpr SignalDef ft(const char* name, uint8_t start, uint8_t page) {
+  return {name, start, 24, true, kFtFactor, 0, -kS24 * kFtFactor, (kS24 - 1) * kFtFactor, "V/V",
+          MuxRole::multiplexed, page};
+}
+constexpr SignalDef ft_sigma(const char* name, uint8_t start) {
+  return {name, start, 24, false, kSigmaFactor, 0, 0, kU24 * kSigmaFactor, "V/V",
+          MuxRole::multiplexed, 3};
+}
+constexpr auto kMux = MuxRole::multiplexed;
+constexpr SignalDef kCalReadings[] = {
+  {"page", 0, 4, false, 1, 0, 0, kCalReadingsPages - 1, "", MuxRole::multiplexor},
+  {"thermal_valid", 4, 1, false, 1, 0, 0, 1, ""},
+  {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+  {"pump_edge_edges", 8, 16, false, 1, 0, 0, 65535, "", kMux, 0},
+  {"pump_edge_in_force_s", 24, 32, false, 0.01, 0, 0, 4294967295.0 * 0.01, "s", kMux, 0},
+  ft("pump_edge_x_re_v_per_v", 8, 1),
+  ft("pump_edge_x_im_v_per_v", 32, 1),
+  ft("pump_edge_y_re_v_per_v", 8, 2),
+  ft("pump_edge_y_im_v_per_v", 32, 2),
+  ft_sigma("pump_edge_sigma_v_per_v", 8),
+  ft_sigma("pump_edge_scatter_v_per_v", 32),
+  ft("pump_edge_in_force_x_re_v_per_v", 8, 4),
+  ft("pump_edge_in_force_x_im_v_per_v", 32, 4),
+  ft("pump_edge_in_force_y_re_v_per_v", 8, 5),
+  ft("pump_edge_in_force_y_im_v_per_v", 32, 5),
+  {"thermal_damping_per_c", 8, 24, true, 1e-7, 0, -kS24 * 1e-7, (kS24 - 1) * 1e-7, "1/degC",
+   kMux, 6},
+  {"thermal_damping_sigma_per_c", 32, 24, false, 1e-8, 0, 0, kU24 * 1e-8, "1/degC", kMux, 6},
+};
 // The test bench's rate table and thermal chamber (not the gyro).
 constexpr SignalDef kLabTableSignals[] = {
   {"rate_dps", 0, 32, true, 1e-6, 0, -2147483648.0 * 1e-6, 2147483647.0 * 1e-6, "deg/s"},
@@ -185,6 +224,24 @@ constexpr bool fits(std::span<const SignalDef> sigs, uint8_t dlc) {
   return true;
 }
 
+// No two signals present on the same page share a bit; a multiplexed
+// signal's page is one the multiplexor can hold.
+constexpr bool disjoint(std::span<const SignalDef> sigs) {
+  for (std::size_t i = 0; i < sigs.size(); ++i) {
+    for (std::size_t j = i + 1; j < sigs.size(); ++j) {
+      const SignalDef& a = sigs[i];
+      const SignalDef& b = sigs[j];
+      const bool both = a.mux != MuxRole::multiplexed || b.mux != MuxRole::multiplexed ||
+                        a.mux_value == b.mux_value;
+      if (both && a.start_bit < b.start_bit + b.length && b.start_bit < a.start_bit + a.length) {
+        return false;
+      }
+    }
+    if (sigs[i].mux == MuxRole::multiplexed && sigs[i].mux_value >= kCalReadingsPages) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 // clang-format off
@@ -203,6 +260,7 @@ const std::array<MessageDef, kTelemetryCount> kTelemetry = {{
   {"HRG_CAN_STATS",   0x10B, 8,   1, "HRG", kCanStats},
   {"HRG_ROW",         0x10C, 8, 100, "HRG", kRow},
   {"HRG_REFERENCE",   0x10D, 5,   1, "HRG", kReference},
+  {"HRG_CAL_READINGS",0x10E, 8,  10, "HRG", kCalReadings},
 }};
 
 const MessageDef kLabTable = {"LAB_TABLE", kLabTableId, 7, 0, "LAB", kLabTableSignals};
@@ -230,7 +288,9 @@ const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages = {{
 static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoops, 8) &&
               fits(kPump, 7) && fits(kStatus, 7) && fits(kEstDamping, 8) && fits(kEstSplit, 7) &&
               fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8) &&
-              fits(kRow, 8) && fits(kReference, 5) && fits(kLabTableSignals, 7));
+              fits(kRow, 8) && fits(kReference, 5) && fits(kLabTableSignals, 7) &&
+              fits(kCalReadings, 8));
+static_assert(disjoint(kStatus) && disjoint(kCalReadings));
 static_assert(fits(kSetMode, 3) && fits(kIdent, 3) && fits(kWindow, 6) && fits(kAgc, 4) &&
               fits(kStatusRequest, 2) && fits(kReplySignals, 4));
 static_assert(fits(kCalSeedRequest, 1) && fits(kCalKey, 5) && fits(kCalStart, 7) &&

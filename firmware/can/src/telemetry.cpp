@@ -126,10 +126,58 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::row_exc, b(s.row_exc), f);
       break;
     case Tm::reference: put(m, sig::f_ref_hz, s.f_ref_hz, f); break;
+    case Tm::cal_readings: encode_cal_readings(s.estimates, 0, seq, f); return;
   }
   // Every telemetry message ends its table with `seq`.
   const SignalDef* seq_sig = find_signal(m, "seq");
   if (seq_sig != nullptr) put_bits(f, seq_sig->start_bit, seq_sig->length, seq);
+}
+
+void encode_cal_readings(const FirmwareEstimates& e, uint8_t page, uint8_t seq, hal::CanFrame& f) {
+  const MessageDef& m = telemetry_def(Tm::cal_readings);
+  f = hal::CanFrame{};
+  f.id = m.id;
+  f.len = m.dlc;
+  put(m, sig::readings_page, page, f);
+  put(m, sig::thermal_valid, b(e.thermal_damping), f);
+  put_bits(f, m.signals[sig::readings_seq].start_bit, kSeqBits, seq);
+  // Without an edge the feedthrough signals stay zero (0 edges says so).
+  const FirmwareEstimates none{};
+  const FirmwareEstimates& ft = e.feedthrough ? e : none;
+  const auto pair = [&](std::size_t a, double va, std::size_t b2, double vb) {
+    put(m, a, va, f);
+    put(m, b2, vb, f);
+  };
+  switch (page) {
+    case 0:
+      pair(sig::pump_edge_edges, sat_u(ft.edges, 65535), sig::pump_edge_in_force_s, ft.in_force_s);
+      break;
+    case 1:
+      pair(sig::pump_edge_x_re, ft.feedthrough_residual_v_per_v.x_re, sig::pump_edge_x_im,
+           ft.feedthrough_residual_v_per_v.x_im);
+      break;
+    case 2:
+      pair(sig::pump_edge_y_re, ft.feedthrough_residual_v_per_v.y_re, sig::pump_edge_y_im,
+           ft.feedthrough_residual_v_per_v.y_im);
+      break;
+    case 3:
+      pair(sig::pump_edge_sigma, ft.feedthrough_sigma_v_per_v, sig::pump_edge_scatter,
+           ft.feedthrough_scatter_v_per_v);
+      break;
+    case 4:
+      pair(sig::pump_edge_in_force_x_re, ft.feedthrough_in_force_v_per_v.x_re,
+           sig::pump_edge_in_force_x_im, ft.feedthrough_in_force_v_per_v.x_im);
+      break;
+    case 5:
+      pair(sig::pump_edge_in_force_y_re, ft.feedthrough_in_force_v_per_v.y_re,
+           sig::pump_edge_in_force_y_im, ft.feedthrough_in_force_v_per_v.y_im);
+      break;
+    default:
+      pair(sig::thermal_damping_per_c, e.thermal_damping ? e.thermal_damping_per_c : 0.0,
+           sig::thermal_damping_sigma_per_c,
+           e.thermal_damping ? e.thermal_damping_sigma_per_c : 0.0);
+      break;
+  }
 }
 
 hal::CanFrame encode_lab_table(double rate_dps, double temp_c, uint8_t seq) {
@@ -147,21 +195,35 @@ TelemetryEncoder::TelemetryEncoder(const TelemetryConfig& config, uint32_t base_
   if (!config_ok_) config_ = TelemetryConfig::defaults();
 }
 
+namespace {
+
+// HRG_WAVE_Y and HRG_ROW go out in the same frame as HRG_WAVE_X (same row,
+// same seq).
+bool row_part(std::size_t i) {
+  return i == static_cast<std::size_t>(Tm::wave_x) || i == static_cast<std::size_t>(Tm::wave_y) ||
+         i == static_cast<std::size_t>(Tm::row);
+}
+
+}  // namespace
+
+bool TelemetryEncoder::due(std::size_t i, uint64_t frame) const {
+  const uint16_t rate = config_.rate_hz[i];
+  if (rate == 0) return false;
+  // An invalid base rate leaves rates above it: send those every frame.
+  const uint64_t period = rate >= base_rate_hz_ ? 1 : base_rate_hz_ / rate;
+  const std::size_t phase = row_part(i) ? 0 : i;
+  return (frame + phase) % period == 0;
+}
+
+bool TelemetryEncoder::cal_readings_due() const {
+  return page_ == 0 && due(static_cast<std::size_t>(Tm::cal_readings), frame_);
+}
+
 std::size_t TelemetryEncoder::tick(const TelemetrySnapshot& s, std::span<hal::CanFrame> out) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < kTelemetryCount && n < out.size(); ++i) {
-    const uint16_t rate = config_.rate_hz[i];
-    if (rate == 0) continue;
-    // An invalid base rate leaves rates above it: send those every frame.
-    const uint64_t period = rate >= base_rate_hz_ ? 1 : base_rate_hz_ / rate;
-    // HRG_WAVE_Y and HRG_ROW go out in the same frame as HRG_WAVE_X (same
-    // row, same seq).
-    const bool row_part = i == static_cast<std::size_t>(Tm::wave_x) ||
-                          i == static_cast<std::size_t>(Tm::wave_y) ||
-                          i == static_cast<std::size_t>(Tm::row);
-    if (row_part && !s.row_ready) continue;
-    const std::size_t phase = row_part ? 0 : i;
-    if ((frame_ + phase) % period != 0) continue;
+    if (row_part(i) && !s.row_ready) continue;
+    if (!due(i, frame_)) continue;
     encode_now(static_cast<Tm>(i), s, out[n++]);
   }
   ++frame_;
@@ -170,7 +232,14 @@ std::size_t TelemetryEncoder::tick(const TelemetrySnapshot& s, std::span<hal::Ca
 
 void TelemetryEncoder::encode_now(Tm message, const TelemetrySnapshot& s, hal::CanFrame& out) {
   const auto i = static_cast<std::size_t>(message);
-  encode_telemetry(message, s, seq_[i], out);
+  if (message == Tm::cal_readings) {
+    // A set's pages all come from the readings held at its first page.
+    if (page_ == 0) held_ = s.estimates;
+    encode_cal_readings(held_, page_, seq_[i], out);
+    page_ = static_cast<uint8_t>((page_ + 1u) % kCalReadingsPages);
+  } else {
+    encode_telemetry(message, s, seq_[i], out);
+  }
   seq_[i] = static_cast<uint8_t>(seq_[i] + 1u);
 }
 

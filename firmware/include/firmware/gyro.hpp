@@ -171,6 +171,11 @@ class Gyro {
     bool gap_refuted = false;      // the gap harmonic was refuted
   };
   void set_calibration_flags(const CalibrationFlags& f) { calibration_flags_ = f; }
+  // The firmware's own readings for a calibration (HRG_CAL_READINGS): when
+  // the next frame's telemetry starts a set of them, set them before it
+  // (the encoder holds them for the set's pages).
+  bool cal_readings_due() const { return telemetry_.cal_readings_due(); }
+  void set_cal_readings(const can::FirmwareEstimates& e) { snapshot_.estimates = e; }
 
   // Task bodies (rows of kTasks).
   static void task_chain(Gyro& g);

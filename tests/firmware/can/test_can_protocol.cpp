@@ -27,23 +27,32 @@ int edge_values(const SignalDef& s, double* out) {
   return n;
 }
 
+// The signals beside `s` in a frame: on its page (a multiplexed message),
+// the multiplexor itself left out (it holds the page).
+bool beside(const SignalDef& s, const SignalDef& o) {
+  if (&o == &s || o.mux == MuxRole::multiplexor) return false;
+  return s.mux == MuxRole::multiplexor ? o.mux == MuxRole::plain : on_page(o, s.mux_value);
+}
+
 void check_all_edges(const MessageDef& m) {
   for (std::size_t i = 0; i < m.signals.size(); ++i) {
     const SignalDef& s = m.signals[i];
     double edges[5];
     const int n = edge_values(s, edges);
     for (int e = 0; e < n; ++e) {
-      // Every other signal at its maximum: a layout overlap would corrupt it.
+      // Every other signal of its page at its maximum: a layout overlap
+      // would corrupt it.
       CanFrame f;
       f.id = m.id;
       f.len = m.dlc;
-      for (const auto& other : m.signals)
-        encode_signal(other, other.max, f);
+      for (const auto& other : m.signals) {
+        if (other.mux == MuxRole::multiplexor) encode_signal(other, s.mux_value, f);
+        if (beside(s, other)) encode_signal(other, other.max, f);
+      }
       encode_signal(s, edges[e], f);
       DOUBLES_EQUAL(edges[e], decode_signal(s, f), 0.5 * s.factor + 1e-12 * std::fabs(edges[e]));
-      for (std::size_t j = 0; j < m.signals.size(); ++j) {
-        if (j == i) continue;
-        const SignalDef& o = m.signals[j];
+      for (const auto& o : m.signals) {
+        if (!beside(s, o)) continue;
         DOUBLES_EQUAL(o.max, decode_signal(o, f), 0.5 * o.factor + 1e-12 * std::fabs(o.max));
       }
     }
@@ -323,12 +332,99 @@ TEST(Telemetry, DefaultBusLoadIsTheSumOfRateTimesWorstCaseFrameBits) {
   LONGS_EQUAL(125, worst_case_frame_bits(7));
   LONGS_EQUAL(105, worst_case_frame_bits(5));
   // angle (7 B) at 500 Hz; wave x, y, row and loops (8 B), pump (7 B) at 100 Hz;
-  // status (7 B) and exec (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info, can stats (8 B)
-  // and reference (5 B) at 1 Hz.
-  const double bits = 500.0 * 125 + 100.0 * (135 + 135 + 135 + 135 + 125) + 10.0 * (125 + 135) +
-                      2.0 * (135 + 125 + 135) + 1.0 * (135 + 135 + 105);
+  // status (7 B), exec and cal readings (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info,
+  // can stats (8 B) and reference (5 B) at 1 Hz.
+  const double bits = 500.0 * 125 + 100.0 * (135 + 135 + 135 + 135 + 125) +
+                      10.0 * (125 + 135 + 135) + 2.0 * (135 + 125 + 135) + 1.0 * (135 + 135 + 105);
   const double load = bus_load_fraction(TelemetryConfig::defaults(), kBitrateBps);
   DOUBLES_EQUAL(bits / 1e6, load, 1e-12);
-  DOUBLES_EQUAL(0.132765, load, 1e-6);
+  DOUBLES_EQUAL(0.134115, load, 1e-6);
   CHECK(load < 0.5);
+}
+
+namespace {
+
+FirmwareEstimates some_readings() {
+  FirmwareEstimates e;
+  e.feedthrough = true;
+  e.edges = 34;
+  e.feedthrough_residual_v_per_v = {4.019e-4, 6.925e-4, -1.2e-5, 7.5e-6};
+  e.feedthrough_in_force_v_per_v = {-0.1, 0.1, 8.0e-4, -3.14e-7};
+  e.feedthrough_sigma_v_per_v = 2.7e-6;
+  e.feedthrough_scatter_v_per_v = 1.7e-6;
+  e.in_force_s = 1796.25;
+  e.thermal_damping = true;
+  e.thermal_damping_per_c = -0.00391;
+  e.thermal_damping_sigma_per_c = 1.5e-4;
+  return e;
+}
+
+double read(const CanFrame& f, const char* name) {
+  return decode_signal(*find_signal(telemetry_def(Tm::cal_readings), name), f);
+}
+
+}  // namespace
+
+TEST(Telemetry, TheCalibrationReadingsGoOutAsOneSetOfSevenPagesFromTheSameReadings) {
+  // GIVEN the default rates and the firmware's readings in the snapshot
+  TelemetryEncoder enc(TelemetryConfig::defaults(), 1000);
+  TelemetrySnapshot s;
+  s.estimates = some_readings();
+  std::array<CanFrame, kTelemetryCount> out;
+  std::array<CanFrame, kCalReadingsPages> set{};
+  int pages = 0;
+  int due_seen = 0;
+  // WHEN 0.7 s of base frames run, the readings changed after the set began
+  for (int k = 0; k < 700; ++k) {
+    const bool due = enc.cal_readings_due();
+    due_seen += due ? 1 : 0;
+    if (k == 150) s.estimates.edges = 35;  // held: the set keeps 34
+    const std::size_t n = enc.tick(s, out);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (out[j].id != telemetry_def(Tm::cal_readings).id) continue;
+      // THEN page i is the i-th frame of the message (seq i), the first
+      // announced by cal_readings_due
+      LONGS_EQUAL(pages, static_cast<long>(read(out[j], "page")));
+      LONGS_EQUAL(pages, static_cast<long>(read(out[j], "seq")));
+      if (pages == 0) CHECK(due);
+      set[static_cast<std::size_t>(pages++)] = out[j];
+    }
+  }
+  LONGS_EQUAL(kCalReadingsPages, pages);
+  LONGS_EQUAL(1, due_seen);
+  // ... and every reading is back within half its resolution
+  const FirmwareEstimates e = some_readings();
+  LONGS_EQUAL(34, static_cast<long>(read(set[0], "pump_edge_edges")));
+  DOUBLES_EQUAL(e.in_force_s, read(set[0], "pump_edge_in_force_s"), 0.005);
+  const double ft = 1e-8;  // half of 2e-8 V/V
+  DOUBLES_EQUAL(e.feedthrough_residual_v_per_v.x_re, read(set[1], "pump_edge_x_re_v_per_v"), ft);
+  DOUBLES_EQUAL(e.feedthrough_residual_v_per_v.x_im, read(set[1], "pump_edge_x_im_v_per_v"), ft);
+  DOUBLES_EQUAL(e.feedthrough_residual_v_per_v.y_re, read(set[2], "pump_edge_y_re_v_per_v"), ft);
+  DOUBLES_EQUAL(e.feedthrough_residual_v_per_v.y_im, read(set[2], "pump_edge_y_im_v_per_v"), ft);
+  DOUBLES_EQUAL(e.feedthrough_sigma_v_per_v, read(set[3], "pump_edge_sigma_v_per_v"), 5e-10);
+  DOUBLES_EQUAL(e.feedthrough_scatter_v_per_v, read(set[3], "pump_edge_scatter_v_per_v"), 5e-10);
+  // the calibration's own range ends (+-0.1 V/V) fit
+  DOUBLES_EQUAL(-0.1, read(set[4], "pump_edge_in_force_x_re_v_per_v"), ft);
+  DOUBLES_EQUAL(0.1, read(set[4], "pump_edge_in_force_x_im_v_per_v"), ft);
+  DOUBLES_EQUAL(8.0e-4, read(set[5], "pump_edge_in_force_y_re_v_per_v"), ft);
+  DOUBLES_EQUAL(-3.14e-7, read(set[5], "pump_edge_in_force_y_im_v_per_v"), ft);
+  DOUBLES_EQUAL(e.thermal_damping_per_c, read(set[6], "thermal_damping_per_c"), 5e-8);
+  DOUBLES_EQUAL(e.thermal_damping_sigma_per_c, read(set[6], "thermal_damping_sigma_per_c"), 5e-9);
+  for (const auto& f : set)
+    DOUBLES_EQUAL(1, read(f, "thermal_valid"), 0);
+}
+
+TEST(Telemetry, NoReadingIsSentAsNoEdgesAndThermalNotValid) {
+  FirmwareEstimates e = some_readings();
+  e.feedthrough = false;
+  e.thermal_damping = false;
+  for (uint8_t page = 0; page < kCalReadingsPages; ++page) {
+    CanFrame f;
+    encode_cal_readings(e, page, 3, f);
+    LONGS_EQUAL(page, static_cast<long>(read(f, "page")));
+    DOUBLES_EQUAL(0, read(f, "thermal_valid"), 0);
+    // Every byte but the page/flags byte and seq is zero: nothing stale.
+    for (int b = 1; b < 7; ++b)
+      LONGS_EQUAL(0, f.data[b]);
+  }
 }

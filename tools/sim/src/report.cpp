@@ -8,6 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "can/estimates_header.hpp"
 #include "recording/recording.hpp"
 #include "recording/recording_writer.hpp"
 #include "sim_run/console.hpp"
@@ -519,35 +520,6 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
-// The firmware's own estimates (FirmwareEstimates) as header keys, for
-// hrg audit --calibration (tools/audit/README.md): absent when not measured.
-void firmware_estimate_metadata(const FirmwareEstimates& e, const fw::PumpEdgeStatus& edges,
-                                Metadata& meta) {
-  const auto put = [&](const char* key, double v) {
-    meta.emplace_back(key, recording::format_number(v));
-  };
-  if (e.feedthrough) {
-    const auto& r = e.feedthrough_residual_v_per_v;
-    const auto& k = e.feedthrough_in_force_v_per_v;
-    meta.emplace_back("pump_edge_edges", std::to_string(edges.edges));
-    put("pump_edge_x_re_v_per_v", r.x_re);
-    put("pump_edge_x_im_v_per_v", r.x_im);
-    put("pump_edge_y_re_v_per_v", r.y_re);
-    put("pump_edge_y_im_v_per_v", r.y_im);
-    put("pump_edge_sigma_v_per_v", edges.sigma_v_per_v);
-    put("pump_edge_scatter_v_per_v", edges.scatter_v_per_v);
-    put("pump_edge_in_force_s", edges.in_force_s);
-    put("pump_edge_in_force_x_re_v_per_v", k.x_re);
-    put("pump_edge_in_force_x_im_v_per_v", k.x_im);
-    put("pump_edge_in_force_y_re_v_per_v", k.y_re);
-    put("pump_edge_in_force_y_im_v_per_v", k.y_im);
-  }
-  if (e.thermal_damping) {
-    put("damping_check_thermal_damping_per_c", e.thermal_damping_per_c);
-    put("damping_check_thermal_damping_sigma_per_c", e.thermal_damping_sigma_per_c);
-  }
-}
-
 std::vector<std::pair<std::string, std::string>> telemetry_metadata(const RunConfig& job) {
   return {{"source", "hrg sim (firmware + sim_target in lockstep)"},
           {"scenario", job.description},
@@ -556,8 +528,11 @@ std::vector<std::pair<std::string, std::string>> telemetry_metadata(const RunCon
 
 // The run's header: the above and the firmware's own estimates.
 Metadata telemetry_metadata(const RunConfig& job, const RunResult& r) {
+  // The firmware's own estimates, for hrg audit --calibration
+  // (tools/audit/README.md): absent when not measured.
   Metadata meta = telemetry_metadata(job);
-  firmware_estimate_metadata(r.firmware_estimates, r.pump_edge, meta);
+  for (auto& kv : hrg::can::estimates_header(r.firmware_estimates))
+    meta.push_back(std::move(kv));
   return meta;
 }
 

@@ -471,8 +471,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.self_calibration_applied = firmware->self_calibration();
   r.final_calibration = firmware->calibration();
   r.pump_edge = gyro.status().pump_edge;
-  r.firmware_estimates = firmware_estimates(
-      r.pump_edge, firmware->estimator().thermal_damping_reading(), r.final_calibration);
+  r.firmware_estimates = firmware->estimates();
   r.can_bus_off_events = target.can().counters().bus_off_events;
   r.can_restarts = gyro.can_restarts();
   summarise_identification(r, job, *firmware);

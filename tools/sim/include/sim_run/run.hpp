@@ -144,24 +144,8 @@ struct TaskFigures {
 };
 
 // The firmware's own estimates of what a calibration holds, beside the
-// audit's (tools/audit/README.md, "--calibration"): the switch-off step
-// check's residual feedthrough, referred to the raw pickoffs, on top of the
-// feedthrough in force while its edges were read; the damping model check's
-// thermal damping (fw::EstimatorPort::thermal_damping_reading).
-struct FirmwareEstimates {
-  bool feedthrough = false;  // at least one switch-off edge measured
-  dsp::FeedthroughCoefficients<double> feedthrough_residual_v_per_v{};
-  dsp::FeedthroughCoefficients<double> feedthrough_in_force_v_per_v{};
-  bool thermal_damping = false;
-  double thermal_damping_per_c = 0.0;
-  double thermal_damping_sigma_per_c = 0.0;
-};
-
-// The firmware's estimates at the end of a run, the calibration `in_force`
-// then.
-FirmwareEstimates firmware_estimates(const fw::PumpEdgeStatus& edges,
-                                     const fw::EstimatorPort::ThermalDampingReading& thermal,
-                                     const fw::Calibration& in_force);
+// audit's (fw::app::Firmware::estimates(); HRG_CAL_READINGS on the bus).
+using FirmwareEstimates = fw::can::FirmwareEstimates;
 
 struct RunResult {
   bool reached_operate = false;

@@ -71,11 +71,20 @@ class Firmware {
   static constexpr uint32_t kMaxSelfCalRounds = 4;
 
   void run_frame() {
+    // Once per set of HRG_CAL_READINGS (0.7 s at the default rate), not per
+    // frame: the referral to the raw pickoffs costs four sines.
+    if (gyro_.cal_readings_due()) gyro_.set_cal_readings(estimates());
     gyro_.run_frame();
     judge_calibration();
     if (cfg_.online_pickoff_calibration) self_calibrate();
   }
   const SelfCalibrationStatus& self_calibration() const { return self_cal_; }
+  // The firmware's own readings of what a calibration holds, now: the
+  // switch-off step check's residual referred to the raw pickoffs through
+  // the calibration in force (its edges were read through it: a change of
+  // it resets the check), and the damping model check's thermal damping.
+  // What HRG_CAL_READINGS sends and hrg sim writes into its recording.
+  can::FirmwareEstimates estimates() const;
   Gyro& gyro() { return gyro_; }
   const Gyro& gyro() const { return gyro_; }
   const DspChainPort& chain() const { return chain_; }

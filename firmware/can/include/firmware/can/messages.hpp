@@ -15,13 +15,15 @@ namespace hrg::fw::can {
 //
 // Identifiers: host commands 0x080-0x08F (highest priority), the command reply
 // 0x090, the calibration service 0x0A0-0x0A8, the test bench's LAB_TABLE 0x0C0,
-// telemetry 0x100-0x10D. Every telemetry message and the reply carry a
+// telemetry 0x100-0x10E. Every telemetry message and the reply carry a
 // rolling 8-bit `seq` that increments per message sent, so a reader counts
 // losses per message. Commands carry a 4-bit `counter` and a CRC-8 (see
 // command.hpp).
 
 // 2: HRG_WAVE_X/Y against the fixed reference of HRG_REFERENCE, HRG_ROW.
-inline constexpr uint8_t kProtocolVersion = 2;
+// 3: HRG_CAL_READINGS, the firmware's own readings for a calibration file (a
+//    log of protocol 3 without them holds none, one of 2 cannot).
+inline constexpr uint8_t kProtocolVersion = 3;
 inline constexpr uint32_t kBitrateBps = 1'000'000;
 
 // Telemetry messages, in table order (index into kTelemetry).
@@ -40,8 +42,13 @@ enum class Tm : uint8_t {
   can_stats,
   row,
   reference,
+  cal_readings,
 };
-inline constexpr std::size_t kTelemetryCount = 14;
+inline constexpr std::size_t kTelemetryCount = 15;
+
+// HRG_CAL_READINGS is multiplexed: one page per frame, pages 0 to
+// kCalReadingsPages - 1 in turn, all of one set from the same readings.
+inline constexpr uint8_t kCalReadingsPages = 7;
 
 // Host commands, in table order (index into kCommands); id = 0x080 + index.
 enum class Cmd : uint8_t { set_mode, ident, window, agc, status_request };
@@ -108,6 +115,25 @@ enum CanStats : uint8_t {
 };
 enum Row : uint8_t { row_t_s, row_pump_v, row_seq, row_exc };
 enum Reference : uint8_t { f_ref_hz, reference_seq };
+enum CalReadings : uint8_t {
+  readings_page,
+  thermal_valid,
+  readings_seq,
+  pump_edge_edges,
+  pump_edge_in_force_s,
+  pump_edge_x_re,
+  pump_edge_x_im,
+  pump_edge_y_re,
+  pump_edge_y_im,
+  pump_edge_sigma,
+  pump_edge_scatter,
+  pump_edge_in_force_x_re,
+  pump_edge_in_force_x_im,
+  pump_edge_in_force_y_re,
+  pump_edge_in_force_y_im,
+  thermal_damping_per_c,
+  thermal_damping_sigma_per_c
+};
 enum LabTable : uint8_t { table_rate_dps, table_temp_c, table_seq };
 enum SetMode : uint8_t { target_mode, set_mode_counter, set_mode_crc };
 enum Ident : uint8_t { action, ident_counter, ident_crc };

@@ -9,6 +9,11 @@
 
 namespace hrg::fw::can {
 
+// A signal's part in a multiplexed message (DBC `M` and `mN`): the
+// multiplexor selects the page; a multiplexed signal is in the frame only
+// when the multiplexor's raw value is its `mux_value`; a plain one always is.
+enum class MuxRole : uint8_t { plain, multiplexor, multiplexed };
+
 // One signal of a CAN message, as in the DBC: little-endian (Intel) bit layout,
 // `start_bit` is the LSB position (bit i lives in byte i/8, bit i%8).
 // physical = raw * factor + offset; [min, max] is the valid physical range.
@@ -22,7 +27,15 @@ struct SignalDef {
   double min;
   double max;
   const char* unit;
+  MuxRole mux = MuxRole::plain;
+  uint8_t mux_value = 0;  // the page, for a multiplexed signal
 };
+
+// True when signal `s` is in a frame whose multiplexor reads `page` (always
+// for a plain signal or the multiplexor itself).
+constexpr bool on_page(const SignalDef& s, unsigned page) {
+  return s.mux != MuxRole::multiplexed || s.mux_value == page;
+}
 
 // One message: identifier (11-bit), data length and signals. `default_rate_hz`
 // is the telemetry rate (0 for commands and replies, which are sent on event).

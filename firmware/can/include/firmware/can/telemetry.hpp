@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/can/firmware_estimates.hpp"
 #include "firmware/can/messages.hpp"
 #include "firmware/mode.hpp"
 #include "hal/can.hpp"
@@ -65,6 +66,10 @@ struct TelemetrySnapshot {
   // CAN driver state.
   hal::CanCounters can{};
   hal::CanState can_state = hal::CanState::error_active;
+  // The firmware's own readings for a calibration (HRG_CAL_READINGS): read
+  // at a set's first page and held for the others; the firmware refreshes
+  // them only then (TelemetryEncoder::cal_readings_due).
+  FirmwareEstimates estimates{};
 };
 
 // Telemetry rates per message (index = Tm), in Hz; 0 switches a message off.
@@ -81,8 +86,14 @@ struct TelemetryConfig {
 // Bus load (fraction of the bit rate) of a configuration, worst-case stuffing.
 double bus_load_fraction(const TelemetryConfig& config, uint32_t bitrate_bps);
 
-// Encodes one telemetry message from the snapshot with the given sequence value.
+// Encodes one telemetry message from the snapshot with the given sequence
+// value (HRG_CAL_READINGS: its page 0).
 void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::CanFrame& out);
+
+// One page of HRG_CAL_READINGS (page < kCalReadingsPages). Values outside a
+// signal's range saturate (a sigma above its range reads as that range's
+// end); no feedthrough reading is sent as 0 edges and zeros.
+void encode_cal_readings(const FirmwareEstimates& e, uint8_t page, uint8_t seq, hal::CanFrame& out);
 
 // The test bench's LAB_TABLE frame (input rate, temperature): written by the
 // simulator's runner for its rate table, and by tests.
@@ -102,8 +113,13 @@ class TelemetryEncoder {
   // HRG_WAVE_Y and HRG_ROW always go with HRG_WAVE_X, and none of the three
   // while the snapshot's row is not ready.
   std::size_t tick(const TelemetrySnapshot& s, std::span<hal::CanFrame> out);
-  // Encodes one message now (e.g. STATUS on request), advancing its counter.
+  // Encodes one message now (e.g. STATUS on request), advancing its counter
+  // (and HRG_CAL_READINGS' page).
   void encode_now(Tm message, const TelemetrySnapshot& s, hal::CanFrame& out);
+  // True when the next tick() sends page 0 of HRG_CAL_READINGS: the
+  // snapshot's `estimates` are read then and held for the set's pages (the
+  // firmware computes them for that tick only).
+  bool cal_readings_due() const;
   bool config_ok() const { return config_ok_; }
   const TelemetryConfig& config() const { return config_; }
 
@@ -113,6 +129,10 @@ class TelemetryEncoder {
   bool config_ok_;
   uint64_t frame_ = 0;
   std::array<uint8_t, kTelemetryCount> seq_{};
+  uint8_t page_ = 0;          // HRG_CAL_READINGS' next page
+  FirmwareEstimates held_{};  // ... and the readings its set is sent from
+  // Whether message i is sent in the frame `frame` (its period and stagger).
+  bool due(std::size_t i, uint64_t frame) const;
 };
 
 }  // namespace hrg::fw::can
