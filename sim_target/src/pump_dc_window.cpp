@@ -26,9 +26,13 @@ PumpDcWindow pump_dc_window(double period_samples, int max_length) {
     }
   }
   const double s = std::sin(w.lag * theta);
-  w.a = beta.real() + beta.imag() * std::cos(w.lag * theta) / s;
-  w.b = beta.imag() / s;
-  w.norm = 1.0 / (1.0 - w.a + w.b);
+  const double a = beta.real() + beta.imag() * std::cos(w.lag * theta) / s;
+  const double b = beta.imag() / s;
+  const double norm = 1.0 / (1.0 - a + b);
+  w.whole = false;
+  w.w_sum = norm / w.length;
+  w.w_now = -a * norm;
+  w.w_lag = b * norm;
   return w;
 }
 

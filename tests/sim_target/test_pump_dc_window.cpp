@@ -49,7 +49,7 @@ TEST(PumpDcWindow, TakesTheTwoFLineOutExactlyWhenThePeriodIsNotWhole) {
         const double mean = sum / w.length;
         // THEN the DC part is V0^2 / 2 at every sample, to rounding, while
         // the mean of the nearest whole number of samples leaks the line
-        worst_dc = std::fmax(worst_dc, std::fabs(w.dc(mean, s[n], s[n - w.lag]) - 4.5));
+        worst_dc = std::fmax(worst_dc, std::fabs(w.dc(sum, s[n], s[n - w.lag]) - 4.5));
         worst_mean = std::fmax(worst_mean, std::fabs(mean - 4.5));
       }
     }
@@ -65,10 +65,10 @@ TEST(PumpDcWindow, IsThePlainMeanToTheBitWhenThePeriodIsWhole) {
   // GIVEN 5 kHz at 100 kHz: 20 samples, whose mean has no 2f line
   const PumpDcWindow w = pump_dc_window(20.0, kMaxLength);
   LONGS_EQUAL(20, w.length);
-  // THEN the correction is exactly zero and the DC part is the mean's bits
-  CHECK(w.a == 0.0 && w.b == 0.0 && w.norm == 1.0);
-  const double mean = 4.4999999999999991;
-  CHECK(w.dc(mean, 8.7, 0.3) == mean);
+  // THEN no correction: the DC part is the mean's bits, sum / 20
+  CHECK(w.whole);
+  const double sum = 89.999999999999986;
+  CHECK(w.dc(sum, 8.7, 0.3) == sum / 20);
 }
 
 TEST(PumpDcWindow, ThePumpAtItsBestPhaseGrowsTheWaveWithoutPullingItsFrequency) {

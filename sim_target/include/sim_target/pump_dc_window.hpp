@@ -19,22 +19,25 @@
 //
 // with the lag k in 1..4 that keeps |sin k theta| largest (A, B ~ |beta|,
 // so the two squares enter with weights of about 2 %: no gain on the DAC's
-// quantisation or on a switching step). For a whole P, A = B = 0 exactly
-// and a = m to the bit.
+// quantisation or on a switching step). The three weights are formed once,
+// so a step costs three products and no division. For a whole P the line
+// does not leak and a is the mean itself, sum / N, to the bit.
 
 namespace hrg::sim {
 
 struct PumpDcWindow {
-  int length = 20;    // N, squares in the mean
-  int lag = 1;        // k
-  double a = 0.0;     // A
-  double b = 0.0;     // B
-  double norm = 1.0;  // 1 / (1 - A + B)
+  int length = 20;     // N, squares in the sum
+  int lag = 1;         // k
+  bool whole = true;   // P is a whole number of samples: the mean alone
+  double w_sum = 0.0;  // 1 / (N (1 - A + B))
+  double w_now = 0.0;  // -A / (1 - A + B)
+  double w_lag = 0.0;  // B / (1 - A + B)
 
-  // The DC part from the mean of the last N squares, the newest square and
+  // The DC part from the sum of the last N squares, the newest square and
   // the one `lag` samples older, V^2.
-  double dc(double mean, double sq_now, double sq_lag) const {
-    return (mean - a * sq_now + b * sq_lag) * norm;
+  double dc(double sum, double sq_now, double sq_lag) const {
+    if (whole) return sum / length;
+    return w_sum * sum + w_now * sq_now + w_lag * sq_lag;
   }
 };
 

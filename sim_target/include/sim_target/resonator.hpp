@@ -400,7 +400,7 @@ class Resonator {
       } else {
         sum += sq[pos] - leaving;
       }
-      return window.dc(sum / window.length, sq[pos], sq[(pos - window.lag) & kMask]);
+      return window.dc(sum, sq[pos], sq[(pos - window.lag) & kMask]);
     }
     void store() const {
       res.hist_pos_ = pos;
@@ -426,7 +426,7 @@ class Resonator {
     } else {
       pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
     }
-    return dc_window_.dc(pump_sq_sum_ / dc_window_.length, pump_sq_hist_[hist_pos_],
+    return dc_window_.dc(pump_sq_sum_, pump_sq_hist_[hist_pos_],
                          pump_sq_hist_[(hist_pos_ - dc_window_.lag) & kMask]);
   }
   void readd_pump_squares();
