@@ -144,7 +144,8 @@ TEST(ClosedLoopOverTheBand, PatternFollowsHundredDegreesPerSecondAtEveryResonanc
   std::printf("\n");
 }
 
-TEST(ClosedLoopOverTheBand, PumpHoldsTheWaveAtItsThresholdWithNoFrequencyPullAtEveryResonance) {
+TEST(ClosedLoopOverTheBand,
+     PumpHoldsTheVibrationAtItsThresholdWithNoFrequencyPullAtEveryResonance) {
   for (double f : kBandHz) {
     // GIVEN an isotropic resonator at f ringing at the set point, all loops closed
     hrg::sim::ResonatorParams rp = resonator_at(f);

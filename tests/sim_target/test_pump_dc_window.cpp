@@ -71,7 +71,7 @@ TEST(PumpDcWindow, IsThePlainMeanToTheBitWhenThePeriodIsWhole) {
   CHECK(w.dc(sum, 8.7, 0.3) == sum / 20);
 }
 
-TEST(PumpDcWindow, ThePumpAtItsBestPhaseGrowsTheWaveWithoutPullingItsFrequency) {
+TEST(PumpDcWindow, ThePumpAtItsBestPhaseGrowsTheVibrationWithoutPullingItsFrequency) {
   // GIVEN an isotropic resonator at 4.2 and 6 kHz (default Q and pump gain),
   // ringing at 1 V, pumped open loop at 1.5 times its parametric threshold
   // with the pump a quarter turn of 2 phi ahead of the vibration (the chain's pi/4),
