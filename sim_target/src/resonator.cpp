@@ -53,6 +53,10 @@ Resonator::Resonator(const ResonatorParams& params, const ElectrodeParams& elect
 void Resonator::set_params(const ResonatorParams& p) {
   params_ = p;
   expanded_ = false;
+  if (!f_ref_set_) {  // the reference follows the resonator unless set apart
+    f_ref_hz_ = p.f_hz;
+    dt_last_ = -1.0;
+  }
 }
 void Resonator::set_electrodes(const ElectrodeParams& e) {
   electrodes_ = e;
@@ -73,6 +77,7 @@ void Resonator::set_temperature_profile(Profile temp_c) {
 }
 void Resonator::set_reference_hz(double f_hz) {
   f_ref_hz_ = f_hz;
+  f_ref_set_ = true;
   dt_last_ = -1.0;  // recompute the <V^2> window at the next step
 }
 
@@ -179,7 +184,7 @@ void Resonator::readd_pump_squares() {
   // Re-added exactly once per ring turn: the running sum's rounding cannot drift.
   constexpr int kMask = kHistory - 1;
   pump_sq_sum_ = 0.0;
-  for (int i = 0; i < avg_len_; ++i)
+  for (int i = 0; i < dc_window_.length; ++i)
     pump_sq_sum_ += pump_sq_hist_[(hist_pos_ - i) & kMask];
   pump_sum_valid_ = true;
 }
@@ -191,8 +196,7 @@ void Resonator::prepare_step(double rate_rad_s, double w, double dt_s) {
   }
   if (dt_s != dt_last_) {
     dt_last_ = dt_s;
-    avg_len_ = std::max(
-        1, std::min(kHistory - 1, static_cast<int>(std::lround(1.0 / (f_ref_hz_ * dt_s)))));
+    dc_window_ = pump_dc_window(1.0 / (f_ref_hz_ * dt_s), kHistory - 1);
     pump_sum_valid_ = false;
   }
   // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only

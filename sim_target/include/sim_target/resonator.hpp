@@ -9,7 +9,9 @@
 //   = F_y F = k_pump (V^2 - <V^2>) G [x, y] + k_s <V^2> G [x, y] + g [V_fx, V_fy] - kappa
 //   (x^2+y^2)[x, y]
 //
-// <V^2> is V^2 averaged over one period of the reference (its DC part); the
+// <V^2> is the DC part of V^2: the mean over the whole samples nearest one
+// period of the reference, with the 2w line that leaks through it when the
+// period is not a whole number of samples taken out (PumpDcWindow); the
 // first term is the parametric pump (2w part of V^2), the second the
 // electrostatic spring (k_s = 0 unless Effects::electrostatic_spring is on),
 // G the gap pattern (ElectrodeParams). The drive voltages are held over each
@@ -44,6 +46,7 @@
 
 #include "sim_target/params.hpp"
 #include "sim_target/profile.hpp"
+#include "sim_target/pump_dc_window.hpp"
 
 namespace hrg::sim {
 
@@ -72,7 +75,8 @@ class Resonator {
   void set_rate_profile(Profile rate_rad_s);     // Omega(t), rad/s
   void set_temperature_profile(Profile temp_c);  // T(t), degC
   // Reference frequency that defines the DC part of V^2 (one period average)
-  // and the quarter-period used by the feedthrough phase; default f_hz.
+  // and the quarter-period used by the feedthrough phase; default (and after
+  // set_params(), until this is called) the resonator's f_hz.
   void set_reference_hz(double f_hz);
   void set_time(double t_s) {
     t0_s_ = t_s;
@@ -170,7 +174,7 @@ class Resonator {
   // The linear part of one step (propagator at the rate, forcers, pump
   // and spring), the <V^2> history advanced by the drive's pump voltage.
   [[gnu::always_inline]] Vec4 propagate(const Drive& drive, const Vec4& u) {
-    // Pump history: <V^2> over one reference period (the DC part of V^2).
+    // Pump history: <V^2>, the DC part of V^2 over one reference period.
     const double v2_dc = push_pump(drive.pump_v);
     // [propagator u; pump sensitivity u] in one 8x4 product.
     const Eigen::Matrix<double, 8, 1> terms = rate_gap_ * u;
@@ -379,13 +383,13 @@ class Resonator {
           hist(r.pump_hist_.data()),
           sq(r.pump_sq_hist_.data()),
           pos(r.hist_pos_),
-          avg(r.avg_len_),
+          window(r.dc_window_),
           sum(r.pump_sq_sum_),
           valid(r.pump_sum_valid_) {}
     [[gnu::always_inline]] double push(double pump_v) {
       constexpr int kMask = kHistory - 1;
       pos = (pos + 1) & kMask;
-      const double leaving = sq[(pos - avg) & kMask];
+      const double leaving = sq[(pos - window.length) & kMask];
       hist[pos] = pump_v;
       sq[pos] = pump_v * pump_v;
       if (pos == 0 || !valid) [[unlikely]] {
@@ -396,7 +400,7 @@ class Resonator {
       } else {
         sum += sq[pos] - leaving;
       }
-      return sum / avg;
+      return window.dc(sum, sq[pos], sq[(pos - window.lag) & kMask]);
     }
     void store() const {
       res.hist_pos_ = pos;
@@ -407,14 +411,14 @@ class Resonator {
     double* hist;
     double* sq;
     int pos;
-    int avg;
+    PumpDcWindow window;
     double sum;
     bool valid;
   };
   double push_pump(double pump_v) {      // records the held pump voltage, returns <V^2>
     constexpr int kMask = kHistory - 1;  // kHistory is a power of two
     hist_pos_ = (hist_pos_ + 1) & kMask;
-    const double leaving = pump_sq_hist_[(hist_pos_ - avg_len_) & kMask];
+    const double leaving = pump_sq_hist_[(hist_pos_ - dc_window_.length) & kMask];
     pump_hist_[hist_pos_] = pump_v;
     pump_sq_hist_[hist_pos_] = pump_v * pump_v;
     if (hist_pos_ == 0 || !pump_sum_valid_) {
@@ -422,7 +426,8 @@ class Resonator {
     } else {
       pump_sq_sum_ += pump_sq_hist_[hist_pos_] - leaving;
     }
-    return pump_sq_sum_ / avg_len_;
+    return dc_window_.dc(pump_sq_sum_, pump_sq_hist_[hist_pos_],
+                         pump_sq_hist_[(hist_pos_ - dc_window_.lag) & kMask]);
   }
   void readd_pump_squares();
   PickoffOutput measured_with_effects() const;
@@ -440,6 +445,7 @@ class Resonator {
   ProfileCursor rate_at_;  // rate_ and temp_ at step midpoints, sample by sample
   ProfileCursor temp_at_;
   double f_ref_hz_;
+  bool f_ref_set_ = false;  // set_reference_hz() called: no longer params_.f_hz
   double t0_s_ = 0.0;
   uint64_t steps_ = 0;
   uint64_t cursor_steps_ = 0;  // steps_ at the cursors' last sample
@@ -470,10 +476,13 @@ class Resonator {
   std::array<double, kHistory> pump_hist_{};
   std::array<double, kHistory> pump_sq_hist_{};
   int hist_pos_ = 0;
-  int avg_len_ = 20;
-  double pump_sq_sum_ = 0.0;  // running sum of the last avg_len_ squares
+  PumpDcWindow dc_window_;    // set from f_ref_hz_ and the step at the first step
+  double pump_sq_sum_ = 0.0;  // running sum of the last dc_window_.length squares
   bool pump_sum_valid_ = false;
-  double dt_last_ = 1e-5;
+  // The step the window was set for; none yet, so the first step sets it
+  // (a window fixed at construction would hold 20 samples, one period only
+  // of a 5 kHz reference at 100 kHz, whatever the resonator's frequency).
+  double dt_last_ = -1.0;
 };
 
 }  // namespace hrg::sim

@@ -1401,6 +1401,12 @@ void Auditor::claim_findings(const State& cur, const std::vector<Chosen>& chosen
 // it; `ft` is the switching-edge statistic against the selected model.
 void Auditor::report_locations(const State& baseline, const FeedStat& ft, AuditResult& out) {
   out.locations = locate(d_, baseline.fit.p, baseline.res, eo_.use_forced, ft);
+  if (eo_.use_forced && !d_.forced.empty()) {
+    const ForcedOffset o = forced_offset(d_, baseline.fit.p);
+    out.excitation_offset_hz = o.mean_rad_s / (2.0 * kPi);
+    out.excitation_offset_sigma_hz = o.sigma_rad_s / (2.0 * kPi);
+    out.excitation_mean_pump_v2 = o.mean_v2;
+  }
   add_candidate_locations(d_, out);
   std::sort(out.locations.begin(), out.locations.end(),
             [](const Location& a, const Location& b) { return a.score > b.score; });

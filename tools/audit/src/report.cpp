@@ -114,6 +114,9 @@ std::string to_json(const AuditResult& r) {
   j += ",\n  \"candidates\": " + json_list(r.candidates, candidate_json);
   j += ",\n  \"excitation_segments\": " + std::to_string(r.forced_segments) +
        ",\n  \"excitation_segments_left_out\": " + std::to_string(r.forced_segments_left_out);
+  j += ",\n  \"excitation_offset_mhz\": " + num(r.excitation_offset_hz * 1e3) +
+       ",\n  \"excitation_offset_sigma_mhz\": " + num(r.excitation_offset_sigma_hz * 1e3) +
+       ",\n  \"excitation_mean_pump_v2\": " + num(r.excitation_mean_pump_v2);
   j += ",\n  \"notes\": [";
   for (std::size_t i = 0; i < r.notes.size(); ++i)
     j += (i ? ", " : "") + str(r.notes[i]);
@@ -193,6 +196,14 @@ std::string to_text(const AuditResult& r, const std::string& source) {
                 r.free_segments, r.heldout_segments, r.forced_segments, r.blocks,
                 r.samples_per_block, r.n_effective);
   t += buf;
+  if (r.excitation_offset_sigma_hz > 0.0) {
+    std::snprintf(buf, sizeof buf,
+                  "Excitation segments against the free decays (baseline): %+.3g +- %.2g mHz at "
+                  "mean pump_v^2 %.3g V^2\n",
+                  r.excitation_offset_hz * 1e3, r.excitation_offset_sigma_hz * 1e3,
+                  r.excitation_mean_pump_v2);
+    t += buf;
+  }
   for (const auto& n : r.notes)
     t += "note: " + n + "\n";
   return t;

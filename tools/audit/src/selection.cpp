@@ -507,24 +507,34 @@ void locate_harmonics(const Dataset& d, const Params& p, const std::vector<doubl
 
 // Excitation segments: mean frequency offset while the pump is on.
 void locate_forced(const Dataset& d, const Params& p, std::vector<Location>& out) {
-  const auto fr = forced_residuals(d, p);
-  double m = 0.0, v2 = 0.0, wsum = 0.0;
-  for (std::size_t i = 0; i < fr.size(); ++i) {
-    const double w = 1.0 / (d.forced[i].sigma_rad_s * d.forced[i].sigma_rad_s);
-    m += w * fr[i], v2 += d.forced[i].mean_v2 / static_cast<double>(fr.size()), wsum += w;
-  }
-  m /= wsum;
-  const double chi = m * m * wsum;
-  if (chi > 25.0) {
+  const ForcedOffset o = forced_offset(d, p);
+  const double z = o.mean_rad_s / o.sigma_rad_s;
+  if (z * z > 25.0) {
     out.push_back({"wave frequency",
                    fmt("excitation segments (pump on, mean pump_v^2 %.3g V^2): %.3g mHz "
                        "off the free-decay frequency",
-                       v2, m / (2.0 * kPi) * 1e3),
-                   chi});
+                       o.mean_v2, o.mean_rad_s / (2.0 * kPi) * 1e3),
+                   z * z});
   }
 }
 
 }  // namespace
+
+ForcedOffset forced_offset(const Dataset& d, const Params& p) {
+  const auto fr = forced_residuals(d, p);
+  ForcedOffset o;
+  double wsum = 0.0;
+  for (std::size_t i = 0; i < fr.size(); ++i) {
+    const double w = 1.0 / (d.forced[i].sigma_rad_s * d.forced[i].sigma_rad_s);
+    o.mean_rad_s += w * fr[i], o.mean_v2 += d.forced[i].mean_v2 / static_cast<double>(fr.size());
+    wsum += w;
+  }
+  if (wsum > 0.0) {
+    o.mean_rad_s /= wsum;
+    o.sigma_rad_s = 1.0 / std::sqrt(wsum);
+  }
+  return o;
+}
 
 std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
                              bool use_forced, const FeedStat& ft) {

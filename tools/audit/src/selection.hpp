@@ -31,6 +31,15 @@ FeedStat feedthrough_stat(const Dataset& d, const Params& p, double ln_neff);
 // Effective sample fraction from the lag-1 correlation of the block residuals.
 double effective_fraction(const std::vector<double>& res, std::size_t n_free_res);
 
+// The excitation segments' frequency against the free-decay model p: the
+// weighted mean offset and its 1-sigma (rad/s), the mean pump_v^2 (V^2).
+struct ForcedOffset {
+  double mean_rad_s = 0.0;
+  double sigma_rad_s = 0.0;
+  double mean_v2 = 0.0;
+};
+ForcedOffset forced_offset(const Dataset& d, const Params& p);
+
 // Where the model misfits, strongest first.
 std::vector<Location> locate(const Dataset& d, const Params& p, const std::vector<double>& res,
                              bool use_forced, const FeedStat& ft);

@@ -178,6 +178,12 @@ struct AuditResult {
   // Excitation segments left out because their pump_v jitters from row to
   // row (the rows alias the pump; a note says why).
   int forced_segments_left_out = 0;
+  // The excitation segments' ringing frequency against the baseline's free
+  // decays: weighted mean offset and its 1-sigma (Hz), mean pump_v^2 (V^2);
+  // 0 without excitation segments. A pump at its ideal phase pulls nothing.
+  double excitation_offset_hz = 0.0;
+  double excitation_offset_sigma_hz = 0.0;
+  double excitation_mean_pump_v2 = 0.0;
   int heldout_segments = 0;
   int blocks = 0;
   int samples_per_block = 1;
