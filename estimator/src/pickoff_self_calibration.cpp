@@ -180,6 +180,8 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
   r.nu_per_s = e.p(0);
   r.dnu_c_per_s = e.p(1);
   r.dnu_s_per_s = e.p(2);
+  r.dnu_c_sigma_per_s = std::sqrt(e.n_inv(1, 1) * var);
+  r.dnu_s_sigma_per_s = std::sqrt(e.n_inv(2, 2) * var);
   // rho = (k - 1)/(k + 1) with k = (1 + g)^2: 1 + g = sqrt((1 + rho)/(1 - rho)).
   r.gain = std::sqrt((1.0 + rho) / (1.0 - rho)) - 1.0;
   r.gain_sigma = std::sqrt(e.n_inv(kRho, kRho) * var) / ((1.0 - rho) * std::sqrt(1.0 - rho * rho));
@@ -214,6 +216,17 @@ void PickoffSelfCalibration::refer_to_applied(const PickoffSelfCalResult& applie
   VecQ dq = VecQ::Zero();
   dq(kPhi) = applied.phase_rad;
   subtract_from_observation<kQ + 1>(aq_, dq);
+}
+
+double damping_anisotropy_disagreement_sigmas(const PickoffSelfCalResult& r, const ParamVector& p,
+                                              double sigma_dnu_c_per_s, double sigma_dnu_s_per_s) {
+  if (r.status != Status::ok || !r.decay_consistent) return 0.0;
+  const auto z = [](double a, double b, double sa, double sb) {
+    const double s = std::hypot(sa, sb);
+    return s > 0.0 ? std::fabs(a - b) / s : 0.0;
+  };
+  return std::max(z(p(kDnuC), r.dnu_c_per_s, sigma_dnu_c_per_s, r.dnu_c_sigma_per_s),
+                  z(p(kDnuS), r.dnu_s_per_s, sigma_dnu_s_per_s, r.dnu_s_sigma_per_s));
 }
 
 }  // namespace hrg::est

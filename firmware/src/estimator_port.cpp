@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "firmware/estimator_port.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hrg::fw {
@@ -188,6 +189,14 @@ void EstimatorPort::solve() {
   for (double c : cov)
     covered += c > 0.0 ? 1 : 0;
   health_.coverage = static_cast<double>(covered) / static_cast<double>(cov.size());
+}
+
+double EstimatorPort::readout_damping_sigmas() const {
+  if (!est_.has_model()) return 0.0;
+  const est::ParamMatrix& c = est_.last_solution().covariance;
+  return est::damping_anisotropy_disagreement_sigmas(
+      self_cal_result_, est_.model(), std::sqrt(std::max(c(est::kDnuC, est::kDnuC), 0.0)),
+      std::sqrt(std::max(c(est::kDnuS, est::kDnuS), 0.0)));
 }
 
 Identification EstimatorPort::identification() const {

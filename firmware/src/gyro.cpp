@@ -273,8 +273,11 @@ void Gyro::check_model() {
   // A control-loop drift once measured and added, no longer added, leaves
   // the output short of it: not one the firmware stands behind while so.
   const bool control_lost = cfg_.compensate_control_drift && h.control_drift_lost;
+  const bool readout_in_damping = cfg_.max_readout_damping_sigmas > 0.0 &&
+                                  h.readout_damping_sigmas > cfg_.max_readout_damping_sigmas;
   status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0) &&
-                               status_.pump_edge.verdict != PumpEdgeVerdict::step && !control_lost;
+                               status_.pump_edge.verdict != PumpEdgeVerdict::step &&
+                               !control_lost && !readout_in_damping;
 }
 
 void Gyro::restart_identification() {

@@ -113,6 +113,34 @@ TEST(PickoffSelfCalibration, GainAndMisalignmentComeFromTheLevelWhileTheTableTur
   DOUBLES_EQUAL(p(kDnuS), r.dnu_s_per_s, 0.1 * p(kNu) * 0.05);
 }
 
+TEST(PickoffSelfCalibration, AModelThatTookTheLevelPatternForDampingStandsOutOfItsSigmas) {
+  // GIVEN the pickoff map identified with the damping alongside
+  const Map truth{0.01, 0.5 * kDeg};
+  const PickoffSelfCalResult r = run_windows(truth, kMixedRates, 40);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
+  CHECK_TRUE(r.dnu_c_sigma_per_s > 0.0 && r.dnu_s_sigma_per_s > 0.0);
+  const double sc = r.dnu_c_sigma_per_s;
+  const double ss = r.dnu_s_sigma_per_s;
+  // THEN the true damping stands within its sigmas (sqrt 2 of each: both
+  // fits' sigmas count), a model whose dnu_S is 20 sigmas off stands at
+  // 20 / sqrt 2 = 14.1 less what the estimate's own error moves it by,
+  ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
+  const double z_true = hrg::est::damping_anisotropy_disagreement_sigmas(r, p, sc, ss);
+  CHECK_TRUE(z_true < 3.0);
+  p(kDnuS) += 20.0 * ss;
+  const double z_off = hrg::est::damping_anisotropy_disagreement_sigmas(r, p, sc, ss);
+  DOUBLES_EQUAL(20.0 / std::sqrt(2.0), z_off, z_true + 1e-9);
+  // and nothing is said when the windows did not hold one decay rate or the
+  // solve was refused.
+  PickoffSelfCalResult inconsistent = r;
+  inconsistent.decay_consistent = false;
+  DOUBLES_EQUAL(0.0, hrg::est::damping_anisotropy_disagreement_sigmas(inconsistent, p, sc, ss),
+                0.0);
+  PickoffSelfCalResult refused = r;
+  refused.status = Status::ill_conditioned;
+  DOUBLES_EQUAL(0.0, hrg::est::damping_anisotropy_disagreement_sigmas(refused, p, sc, ss), 0.0);
+}
+
 TEST(PickoffSelfCalibration, AppliedAndIdentifiedAgainTheResidualMapVanishes) {
   // The firmware applies the identified inverse and keeps identifying on the
   // corrected signals: what is left is within the noise.

@@ -19,6 +19,12 @@ struct EstimatorHealth {
   // A control-loop drift the estimator measured and added is no longer
   // added (est::Estimator::pump_drift_lost): the compensated output misses it.
   bool control_drift_lost = false;
+  // Standard errors between the model's damping anisotropy and the one the
+  // pickoff self-identification solves with the pickoff level patterns
+  // alongside (est::damping_anisotropy_disagreement_sigmas; 0 while either
+  // has nothing to say): large when the model took a readout pattern for
+  // damping.
+  double readout_damping_sigmas = 0.0;
 };
 
 }  // namespace hrg::fw

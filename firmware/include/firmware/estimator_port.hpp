@@ -26,6 +26,7 @@ class EstimatorPort final : public ResonatorIdentifier {
   EstimatorHealth health() const override {
     EstimatorHealth h = health_;
     h.control_drift_lost = est_.pump_drift_lost();
+    h.readout_damping_sigmas = readout_damping_sigmas();
     return h;
   }
   Identification identification() const override;
@@ -103,6 +104,8 @@ class EstimatorPort final : public ResonatorIdentifier {
   uint32_t solves_accepted() const { return solves_ok_; }
 
  private:
+  // EstimatorHealth::readout_damping_sigmas of the model in force.
+  double readout_damping_sigmas() const;
   void end_side_windows();
   // The damping scale of the thermal probe at the measured temperature.
   double probe_scale() const;

@@ -47,6 +47,14 @@ struct GyroConfig {
   // the table turns), which inflated sigma_hat and with it the tolerance of
   // every check. When the model holds, the misfit is 1 +- ~0.1.
   double min_window_misfit = 0.25;
+  // ... and not while the model's damping anisotropy stands more than this
+  // many standard errors from the one solved with the pickoff level patterns
+  // alongside (EstimatorHealth::readout_damping_sigmas): the model then took
+  // a pickoff gain or misalignment's 4 theta pattern in E, read while the
+  // table turned, for damping. The significance the firmware asks of the
+  // same identification before it applies it (fw::app::Firmware::
+  // kSelfCalSignificance). 0: not checked.
+  double max_readout_damping_sigmas = 5.0;
   // Do no harm while the pump runs: the step of the corrected signal at
   // every switch-off (PumpEdgeCheck). A step above its tolerance makes the
   // compensation not valid.
