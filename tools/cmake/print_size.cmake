@@ -6,29 +6,28 @@ set(grand_text 0)
 set(grand_data 0)
 set(grand_bss 0)
 
-# Right-aligns NUMBER in a field of WIDTH characters.
-function(hrg_pad_left out number width)
-  string(LENGTH "${number}" len)
+# The blanks that fill TEXT out to WIDTH characters (at least one).
+function(hrg_fill out text width)
+  string(LENGTH "${text}" len)
   math(EXPR pad "${width} - ${len}")
   if(pad LESS 1)
     set(pad 1)
   endif()
   string(REPEAT " " ${pad} spaces)
-  set(${out} "${spaces}${number}" PARENT_SCOPE)
+  set(${out} "${spaces}" PARENT_SCOPE)
 endfunction()
 
-# One report line: NAME left in 38 characters, then the three sizes.
+# One report line: NAME left in 38 characters, then the three sizes
+# right-aligned in 8 each.
 function(hrg_size_line name text data bss)
-  string(LENGTH "${name}" len)
-  math(EXPR pad "38 - ${len}")
-  if(pad LESS 1)
-    set(pad 1)
-  endif()
-  string(REPEAT " " ${pad} spaces)
-  hrg_pad_left(t "${text}" 8)
-  hrg_pad_left(d "${data}" 8)
-  hrg_pad_left(b "${bss}" 8)
-  message("${name}${spaces}${t}${d}${b}")
+  set(line "${name}")
+  hrg_fill(gap "${name}" 38)
+  string(APPEND line "${gap}")
+  foreach(n IN ITEMS "${text}" "${data}" "${bss}")
+    hrg_fill(gap "${n}" 8)
+    string(APPEND line "${gap}${n}")
+  endforeach()
+  message("${line}")
 endfunction()
 
 set(size_row "^[ \t]*([0-9]+)[ \t]+([0-9]+)[ \t]+([0-9]+)[ \t]+[0-9]+[ \t]+[0-9a-f]+[ \t]+(.*)$")

@@ -18,21 +18,14 @@ Exit status 0 when they agree; prints every key and value compared.
 """
 import os
 import re
-import subprocess
 import sys
+
+from compare import run  # the same runner and exit-status rule as the audit comparison
 
 RES_FT = 2e-8  # V/V, the feedthrough signals' resolution
 RES_SIGMA = 1e-9  # V/V, their sigma's
 SET_PERIOD_S = 0.7  # one set of 7 pages at 10 Hz, held from its first page
 PARTS = ("x_re", "x_im", "y_re", "y_im")
-
-
-def run(cmd):
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    if p.returncode not in (0, 1):  # hrg sim exits 1 for its own checks on short runs
-        sys.stdout.write(p.stdout + p.stderr)
-        raise SystemExit(f"failed ({p.returncode}): {' '.join(cmd)}")
-    return p.stdout
 
 
 def header(path):
