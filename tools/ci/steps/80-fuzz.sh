@@ -14,7 +14,7 @@ out=${HRG_FUZZ_DIR:-build/fuzz}
 mkdir -p "$out"
 command -v clang++ >/dev/null || { echo "fuzz: clang++ missing (apt-get install clang)" >&2; exit 1; }
 flags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
-  -Ihal/include -Ifirmware/include -Ifirmware/can/include -Itools)
+  -Ihal/include -Idsp/include -Ifirmware/include -Ifirmware/can/include -Itools)
 can_src=(firmware/can/src/signal.cpp firmware/can/src/messages.cpp firmware/can/src/command.cpp
   firmware/can/src/telemetry.cpp)
 clang++ "${flags[@]}" tests/fuzz/fuzz_command_decoder.cpp "${can_src[@]}" \
