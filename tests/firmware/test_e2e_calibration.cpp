@@ -16,6 +16,7 @@
 #include "sim_run/report.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(CalibrationLoop);
@@ -27,11 +28,7 @@ using hrg::fw::app::CalibrationVerdict;
 using hrg::sim_run::RunConfig;
 using hrg::sim_run::RunResult;
 
-RunConfig default_scenario() {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
-  return hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", {});
-}
+RunConfig default_scenario() { return hrg::test::default_scenario_run(); }
 
 RunConfig with_gain_mismatch(double gain) {
   RunConfig j = default_scenario();

@@ -17,6 +17,7 @@
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(FeedthroughDoNoHarm);
@@ -36,11 +37,9 @@ const cplx kX = std::polar(1e-3, 30.0 * kDeg);
 const cplx kY = std::polar(5e-4, 30.0 * kDeg);
 
 RunConfig first_minute(bool feedthrough) {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
   hrg::sim_run::ScheduleOptions o;
   o.duration_s = kRunS;
-  RunConfig j = hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", o);
+  RunConfig j = hrg::test::default_scenario_run(o);
   if (feedthrough) {
     auto& ft = j.sim.effects.drive_feedthrough;
     ft.enabled = true;

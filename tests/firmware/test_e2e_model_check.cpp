@@ -16,6 +16,7 @@
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(ModelCheck);
@@ -28,11 +29,9 @@ using hrg::sim_run::RunResult;
 constexpr double kLongPlanS = 1800.0;  // the plan with 5 s windows while the table turns
 
 RunConfig default_scenario_long() {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
   hrg::sim_run::ScheduleOptions o;
   o.duration_s = kLongPlanS;
-  return hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", o);
+  return hrg::test::default_scenario_run(o);
 }
 
 // The resonator of tools/gregory/README.md, "Another resonator".

@@ -13,6 +13,7 @@
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(ThermalLoop);
@@ -25,9 +26,7 @@ using hrg::sim_run::RunResult;
 constexpr double kBetaPerC = 0.004;
 
 RunConfig thermal_damping_gyro() {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
-  RunConfig j = hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", {});
+  RunConfig j = hrg::test::default_scenario_run();
   j.sim.effects.thermal_damping.enabled = true;
   j.sim.effects.thermal_damping.rel_per_c = kBetaPerC;
   j.sim.temp_c = hrg::sim::Profile::sine(1.0, 0.005, 0.0);

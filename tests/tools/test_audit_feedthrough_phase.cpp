@@ -23,6 +23,7 @@
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(AuditFeedthroughPhase);
@@ -43,11 +44,9 @@ struct Case {
 };
 
 RunConfig job(const Case& c) {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
   hrg::sim_run::ScheduleOptions o;
   o.duration_s = kRunS;
-  RunConfig j = hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", o);
+  RunConfig j = hrg::test::default_scenario_run(o);
   auto& ft = j.sim.effects.drive_feedthrough;
   ft = {true, c.x_v_per_v, c.y_v_per_v, c.x_phase_deg, c.y_phase_deg};
   return j;

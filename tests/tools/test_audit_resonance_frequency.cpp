@@ -21,6 +21,7 @@
 #include "sim_run/run.hpp"
 #include "sim_run/scenario_run.hpp"
 
+#include "support/default_scenario.hpp"
 #include "support/cpputest.hpp"
 
 TEST_GROUP_WITHOUT_LEAK_CHECK(AuditResonanceFrequency);
@@ -67,11 +68,9 @@ double steady_pump_share(const RunConfig& j, const RunResult& r) {
 }
 
 Clean run_clean(double f_hz) {
-  const char* src = std::getenv("HRG_SOURCE_DIR");
-  const std::string dir = src ? src : ".";
   hrg::sim_run::ScheduleOptions o;
   o.duration_s = kRunS;
-  RunConfig j = hrg::sim_run::run_from_scenario(dir + "/sim_target/scenarios/default.toml", o);
+  RunConfig j = hrg::test::default_scenario_run(o);
   j.sim.resonator.f_hz = f_hz;
   hrg::sim_run::adopt_resonator(j, "clean gyro");
   const RunResult r = hrg::sim_run::run_simulation(j, {});
