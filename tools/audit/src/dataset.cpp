@@ -324,11 +324,20 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   const cplx dg = pump_per_amplitude(r, q1) - pump_per_amplitude(r, q0);
   f.ft_ax_per_s = dg.real() / f.angle_span_s;
   f.ft_ay_per_s = dg.imag() / f.angle_span_s;
-  const double row_se_rad = d.noise_v / std::sqrt(std::max(f.mean_a2, 1e-30));
-  f.se_rad_s = std::sqrt(2.0 / k) * row_se_rad / (te - ts);
+  // A row's phase noise is noise / a_A at that row's own amplitude, and the
+  // frequency is read from the end rows alone: on the firmware's ring-up
+  // (a_A 0.1 V at its start, 0.95 V at its end) the start carries nearly all
+  // of it, and the segment's mean a_A^2 put its sigma 3.6x low (1.08e-6
+  // against 3.94e-6 rad/s, default scenario at seed 5).
+  double inv_a2_ends = 0.0;  // sum over the 2k end rows of 1 / a_A^2
+  for (std::size_t j = 0; j < k; ++j)
+    inv_a2_ends += 1.0 / std::max(r.a2[q0 + j], 1e-30) + 1.0 / std::max(r.a2[q1 - j], 1e-30);
+  const double noise2 = d.noise_v * d.noise_v;
+  f.se_rad_s = std::sqrt(noise2 * inv_a2_ends) / static_cast<double>(k) / (te - ts);
   f.balance_se_per_s = f.se_rad_s;  // ln a_A and the phase see the same noise per row
   // theta from single rows: half the phase's noise per row (theta = arg / 2).
-  f.angle_se_rad_s = std::sqrt(2.0) * row_se_rad / 2.0 / f.angle_span_s;
+  const double inv_a2_end_rows = 1.0 / std::max(r.a2[q0], 1e-30) + 1.0 / std::max(r.a2[q1], 1e-30);
+  f.angle_se_rad_s = std::sqrt(noise2 * inv_a2_end_rows) / 2.0 / f.angle_span_s;
   d.forced.push_back(f);
 }
 

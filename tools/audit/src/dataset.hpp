@@ -40,7 +40,7 @@ struct ForcedSegment {
   std::size_t first_row = 0, last_row = 0;
   double t0_s = 0.0, t1_s = 0.0;
   double freq_rad_s = 0.0;              // (phase_end - phase_start)/duration in the carrier frame
-  double se_rad_s = 0.0;                // from the white noise
+  double se_rad_s = 0.0;                // from the white noise at the end rows' own a_A
   double sigma_rad_s = 0.0;             // weight in the fit: se and the scatter the model leaves
   double mean_c4 = 0.0, mean_s4 = 0.0;  // mean cos/sin 4 theta
   double theta0_rad = 0.0, theta1_rad = 0.0;
