@@ -3,8 +3,8 @@
 // from its end rows, whose phase noise is noise / a_A at their own
 // amplitude. The firmware's ring-up from rest starts its quiet part at
 // a_A ~ 0.1 V and ends it at 0.95 V, but its sigma was taken at the
-// segment's mean a_A^2 (~0.35 V^2): 1.1e-6 rad/s where the start row alone
-// gives ~4e-6. Over 40 clean 365 s runs (seeds 1-10, 4.2 / 5 / 6 kHz) its
+// segment's mean a_A^2: 1.08e-6 rad/s where its end rows give 3.94e-6
+// (seed 5). Over 40 clean 365 s runs (seeds 1-10, 4.2 / 5 / 6 kHz) its
 // residual stood 4.4 sigma rms from the free decays (9.5 at most), and as
 // the only segment with pump_v^2 100 V^2 and a low a_A^2 it was read as an
 // electrostatic spring (1.31e-8 Hz/V^2 at delta BIC 33, seed 5) or a
