@@ -195,11 +195,13 @@ def thermal_damping_sigmas(text):
     swing_c = temperature_swing_c(s)
     if swing_c is None:
         return None
-    nu_per_s = math.pi * _scenario_value(s, "resonator", "f_hz") / _scenario_value(s, "resonator", "q")
+    nu_per_s = (math.pi * _scenario_value(s, "resonator", "f_hz") /
+                _scenario_value(s, "resonator", "q"))
+    beta_per_c = abs(_scenario_value(s, "effects.thermal_damping", "rel_per_c"))
     noise_v = math.hypot(_scenario_value(s, "adc", "noise_x_v_rms"),
                          _scenario_value(s, "adc", "noise_y_v_rms")) / math.sqrt(2.0)
     sigma_per_s = THERMAL_SWING_SIGMA_PER_S * noise_v / THERMAL_SWING_NOISE_V_RMS
-    return nu_per_s * abs(_scenario_value(s, "effects.thermal_damping", "rel_per_c")) * swing_c / sigma_per_s
+    return nu_per_s * beta_per_c * swing_c / sigma_per_s
 
 
 def row_run_s(edits, text, duration):
