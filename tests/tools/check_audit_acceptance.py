@@ -43,11 +43,8 @@ EXTRA_ROWS = {
 
 
 def audit_row(hrg, scenario, work, row, seed):
-    text = gt.set_seed(open(scenario).read(), seed)
     keys = EXTRA_ROWS[row] if row in EXTRA_ROWS else gt.ROWS[row][0]
-    for section, kv in keys.items():
-        for k, v in kv.items():
-            text = gt.set_key(text, section, k, v)
+    text = gt.row_text(open(scenario).read(), keys, seed)
     d = os.path.join(work, "%s_seed%d" % (row, seed))
     os.makedirs(d, exist_ok=True)
     scen = os.path.join(d, "scenario.toml")

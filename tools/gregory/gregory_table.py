@@ -37,8 +37,9 @@ of a noisy statistic (0.036 to 0.53 deg/h over seeds 1 to 4).
 for every N and printed in the same order. --duration S is passed to every
 hrg sim; without it each row runs at its own length (row_run_s): the
 scenario's, or LONG_RUN_S for the rows with a pickoff gain mismatch or a
-nonlinear damping, each held against the clean gyro run at the same length
-and seed.
+nonlinear damping, and for a thermal damping whose damping swing (nu beta
+A_T) the scenario's run does not resolve to 7 of the audit's sigmas; each
+held against the clean gyro run at the same length and seed.
 """
 import argparse
 import concurrent.futures as cf
@@ -49,6 +50,7 @@ import os
 import re
 import subprocess
 import sys
+import tomllib
 
 # name -> ({section: {key: value}}, pickoff row?)
 ROWS = {
@@ -140,15 +142,81 @@ LONG_RUN_EFFECTS = ("effects.pickoff_gain_mismatch", "effects.nonlinear_damping"
 # not sharpen with the run (sigma ~1.3e-3 at 365 s, 1.7e-3 to 2.7e-3 and
 # biased at 1800 s; tools/gregory/README.md, "The gap rows' length").
 
+# A thermal damping beta shows as the change nu beta dT of the damping (nu =
+# pi f / Q) that the temperature swing makes, read by the audit from the free
+# decays' rates against the temperature. On the scenario's run (~44 windows
+# of 1 s, 1.8 cycles of a 5 mHz sine) its sigma of nu beta A_T (A_T the
+# swing's amplitude) is ~1.6e-6 1/s on either resonator of the table (beta
+# +-0.00052 /degC at the seed's nu 3.14e-3 1/s, +-0.00092 at 1.65e-3; seeds
+# 1-4, 1 uV/sqrt(Hz)), and it grows with the pickoff noise. The audit accepts
+# a finding from 5 sigma: a row whose swing the scenario's run resolves to
+# fewer than 7 (two more for the draw's own scatter) runs LONG_RUN_S, where
+# the 5 s windows give ~13x the precision (tools/gregory/README.md, "Another
+# resonator"): half the seed's nu halves the swing of the same beta.
+THERMAL_SWING_SIGMA_PER_S = 1.6e-6
+THERMAL_SWING_NOISE_V_RMS = 2.2e-4
+THERMAL_SIGMAS_NEEDED = 7.0
 
-def row_run_s(rows, name, duration):
+
+def _scenario_value(scenario, section, key):
+    """scenario[section][key] of a parsed scenario; missing: an error naming it."""
+    table = scenario
+    for part in section.split("."):
+        table = table.get(part, {})
+    if key not in table:
+        raise SystemExit("scenario has no %s in [%s] (needed for the thermal damping row's "
+                         "length)" % (key, section))
+    return table[key]
+
+
+def temperature_swing_c(scenario):
+    """The temperature's amplitude about its middle over the run (degC): a
+    sine's amplitude, half the span of steps or ramps, 0 when constant; None
+    for a table file (not read here)."""
+    temp = scenario.get("temperature", {})
+    kind = temp.get("kind", "constant")
+    if kind == "constant":
+        return 0.0
+    if kind == "sine":
+        return abs(float(_scenario_value(scenario, "temperature", "amplitude_c")))
+    if kind in ("steps", "ramps"):
+        v = _scenario_value(scenario, "temperature", "value_c")
+        return 0.5 * (max(v) - min(v))
+    return None
+
+
+def thermal_damping_sigmas(text):
+    """The audit's expected significance of the thermal damping on the
+    scenario's own run (None: no thermal damping, or a swing not known)."""
+    s = tomllib.loads(text)
+    td = s.get("effects", {}).get("thermal_damping", {})
+    if not td.get("enabled", False):
+        return None
+    swing_c = temperature_swing_c(s)
+    if swing_c is None:
+        return None
+    nu_per_s = (math.pi * _scenario_value(s, "resonator", "f_hz") /
+                _scenario_value(s, "resonator", "q"))
+    beta_per_c = abs(_scenario_value(s, "effects.thermal_damping", "rel_per_c"))
+    noise_v = math.hypot(_scenario_value(s, "adc", "noise_x_v_rms"),
+                         _scenario_value(s, "adc", "noise_y_v_rms")) / math.sqrt(2.0)
+    sigma_per_s = THERMAL_SWING_SIGMA_PER_S * noise_v / THERMAL_SWING_NOISE_V_RMS
+    return nu_per_s * beta_per_c * swing_c / sigma_per_s
+
+
+def row_run_s(edits, text, duration):
     """A row's hrg sim --duration: the one asked for, else the length its
-    effect needs (None: the scenario's own)."""
+    effect needs (None: the scenario's own). edits: the row's keys; text:
+    its scenario."""
     if duration is not None:
         return duration
-    if any(e in rows[name][0] for e in LONG_RUN_EFFECTS):
+    if any(e in edits for e in LONG_RUN_EFFECTS):
+        return LONG_RUN_S
+    z = thermal_damping_sigmas(text)
+    if z is not None and z < THERMAL_SIGMAS_NEEDED:
         return LONG_RUN_S
     return None
+
 
 # The rows whose effect the online self-calibration identifies (gain and
 # misalignment from the level of E, the phase from the level of the
@@ -193,6 +261,15 @@ def set_seed(text, seed):
     return "\n".join(lines)
 
 
+def row_text(base_text, edits, seed=None):
+    """A row's scenario: the base scenario's text with the row's keys (and the seed) set."""
+    text = base_text if seed is None else set_seed(base_text, seed)
+    for section, kv in edits.items():
+        for k, v in kv.items():
+            text = set_key(text, section, k, v)
+    return text
+
+
 def readout_error_deg(telemetry):
     """Largest |theta_A - true pattern angle| (mod 90 deg) over the valid output."""
     worst = 0.0
@@ -212,8 +289,11 @@ def adb(v):
     return "-" if math.isnan(v) else "%.3g" % v
 
 
-def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration=None):
+def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration=None,
+            can_log=None):
     cmd = [hrg, "sim", "--scenario", scenario, "--out", out, "--no-plots", "--quiet"]
+    if can_log is not None:
+        cmd += ["--can-log", can_log]
     if duration is not None:
         cmd += ["--duration", repr(duration)]
     if calibration:
@@ -259,13 +339,7 @@ def kept_pickoff_map(online):
 
 
 def run_row(hrg, base, work, rows, name, duration=None, seed=None):
-    edits, _ = rows[name]
-    text = open(base).read()
-    if seed is not None:
-        text = set_seed(text, seed)
-    for section, kv in edits.items():
-        for k, v in kv.items():
-            text = set_key(text, section, k, v)
+    text = row_text(open(base).read(), rows[name][0], seed)
     d = os.path.join(work, name)
     os.makedirs(d, exist_ok=True)
     scen = os.path.join(d, "scenario.toml")
@@ -342,7 +416,8 @@ def main():
     if "none" not in names:
         names = ["none"] + names
     clean_seeds = parse_seeds(a.clean_seeds) if a.clean_seeds else []
-    length = {n: row_run_s(rows, n, a.duration) for n in names}
+    base = open(a.scenario).read()
+    length = {n: row_run_s(rows[n][0], row_text(base, rows[n][0]), a.duration) for n in names}
     # The clean gyro at every other length a row runs at (same seed).
     other = sorted({v for n, v in length.items() if v != length["none"]})
     # map() returns the rows in the order asked, whichever finishes first.
