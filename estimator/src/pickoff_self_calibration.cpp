@@ -229,4 +229,10 @@ double damping_anisotropy_disagreement_sigmas(const PickoffSelfCalResult& r, con
                   z(p(kDnuS), r.dnu_s_per_s, sigma_dnu_s_per_s, r.dnu_s_sigma_per_s));
 }
 
+double readout_pattern_sigmas(const PickoffSelfCalResult& r) {
+  if (r.status != Status::ok || !r.decay_consistent) return 0.0;
+  const auto z = [](double x, double sigma) { return sigma > 0.0 ? std::fabs(x) / sigma : 0.0; };
+  return std::max(z(r.gain, r.gain_sigma), z(r.misalignment_rad, r.misalignment_sigma_rad));
+}
+
 }  // namespace hrg::est

@@ -235,6 +235,9 @@ void Gyro::task_output(Gyro& g) {
   if (apply && g.cfg_.compensate_control_drift && g.status_.excitation_on) {
     control = g.identifier_.control_drift_rad_s(o);
   }
+  // ... unless the readout's own pattern explains what its fits read.
+  g.status_.control_drift_withheld_rad_s = g.control_drift_withheld_ ? control : 0.0;
+  if (g.control_drift_withheld_) control = 0.0;
   drift += control;
   g.status_.control_drift_rad_s = control;
   const bool valid = g.mode_.permissions().output_valid && !moving_on_purpose;
@@ -250,8 +253,12 @@ void Gyro::task_output(Gyro& g) {
 
 void Gyro::check_model() {
   const EstimatorHealth h = identifier_.health();
+  status_.readout_damping_sigmas = h.readout_damping_sigmas;
   if (!compensation_ready_) {
-    if (!(cfg_.identify ? scheduler_.campaign_done() : h.solved)) return;
+    if (!(cfg_.identify ? scheduler_.campaign_done() : h.solved)) {
+      status_.compensation_reasons = reason_bit(CompensationReason::not_in_force);
+      return;
+    }
     compensation_ready_ = true;
     checks_seen_ = h.windows_checked;  // the campaign's own windows prove nothing
   }
@@ -275,9 +282,28 @@ void Gyro::check_model() {
   const bool control_lost = cfg_.compensate_control_drift && h.control_drift_lost;
   const bool readout_in_damping = cfg_.max_readout_damping_sigmas > 0.0 &&
                                   h.readout_damping_sigmas > cfg_.max_readout_damping_sigmas;
-  status_.compensation_valid = status_.compensation_applied && (!checked || checks_passed_ > 0) &&
-                               status_.pump_edge.verdict != PumpEdgeVerdict::step &&
-                               !control_lost && !readout_in_damping;
+  // D_Phi's fits read the measured amplitude and angle: a readout pattern
+  // the firmware sees makes their estimate one it cannot stand behind.
+  const bool readout_pattern = cfg_.max_readout_pattern_sigmas > 0.0 &&
+                               h.readout_pattern_sigmas > cfg_.max_readout_pattern_sigmas;
+  control_drift_withheld_ =
+      cfg_.compensate_control_drift && (readout_in_damping || readout_pattern);
+  uint8_t why = 0;
+  const auto add = [&why](bool c, CompensationReason r) {
+    if (c) why = static_cast<uint8_t>(why | reason_bit(r));
+  };
+  add(!status_.compensation_applied, CompensationReason::check_failed);
+  add(checked && checks_passed_ == 0, CompensationReason::not_checked);
+  add(status_.pump_edge.verdict == PumpEdgeVerdict::step, CompensationReason::pump_edge_step);
+  add(control_lost, CompensationReason::control_drift_lost);
+  add(readout_in_damping, CompensationReason::readout_in_damping);
+  add(control_drift_withheld_, CompensationReason::control_drift_withheld);
+  status_.compensation_reasons = why;
+  // A withheld D_Phi leaves the output short of a drift only while the
+  // pump's part was in use; otherwise it withholds nothing measured.
+  const auto others =
+      static_cast<uint8_t>(why & ~reason_bit(CompensationReason::control_drift_withheld));
+  status_.compensation_valid = others == 0 && !(control_drift_withheld_ && h.pump_drift_in_use);
 }
 
 void Gyro::restart_identification() {
@@ -287,6 +313,8 @@ void Gyro::restart_identification() {
   failed_before_restart_ = status_.model_checks_failed;
   status_.compensation_applied = false;
   status_.compensation_valid = false;
+  status_.compensation_reasons = reason_bit(CompensationReason::not_in_force);
+  control_drift_withheld_ = false;
 }
 
 void Gyro::task_temperature(Gyro& g) {
@@ -338,6 +366,8 @@ void Gyro::task_telemetry(Gyro& g) {
   s.fault_input = st.fault_input;
   s.ident_active = g.cfg_.identify && !g.scheduler_.campaign_done();
   s.comp_valid = st.compensation_valid;
+  s.comp_reasons = st.compensation_reasons;
+  s.readout_damping_sigmas = st.readout_damping_sigmas;
   s.cal_withdrawn = g.calibration_flags_.withdrawn;
   s.cal_damping_refuted = g.calibration_flags_.damping_refuted;
   s.cal_gap_refuted = g.calibration_flags_.gap_refuted;

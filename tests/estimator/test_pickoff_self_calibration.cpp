@@ -141,6 +141,29 @@ TEST(PickoffSelfCalibration, AModelThatTookTheLevelPatternForDampingStandsOutOfI
   DOUBLES_EQUAL(0.0, hrg::est::damping_anisotropy_disagreement_sigmas(refused, p, sc, ss), 0.0);
 }
 
+TEST(PickoffSelfCalibration, TheReadoutPatternsSignificanceIsTheLargerOfGainAndMisalignment) {
+  // GIVEN the 1 % gain and 0.5 deg misalignment identified from mixed rates
+  const PickoffSelfCalResult r = run_windows(Map{0.01, 0.5 * kDeg}, kMixedRates, 40);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
+  // THEN the pattern stands the larger of |g| / sigma_g and |b| / sigma_b out
+  // (g sigma ~5e-6: thousands of sigmas, far above the firmware's 5)
+  const double z = hrg::est::readout_pattern_sigmas(r);
+  DOUBLES_EQUAL(std::max(r.gain / r.gain_sigma, r.misalignment_rad / r.misalignment_sigma_rad), z,
+                1e-9 * z);
+  CHECK_TRUE(z > 100.0);
+  // AND ideal pickoffs stand within the noise
+  const PickoffSelfCalResult ideal = run_windows(Map{}, kMixedRates, 40);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(ideal.status));
+  CHECK_TRUE(hrg::est::readout_pattern_sigmas(ideal) < 4.0);
+  // AND nothing is said when one decay rate does not hold or the solve was refused
+  PickoffSelfCalResult inconsistent = r;
+  inconsistent.decay_consistent = false;
+  DOUBLES_EQUAL(0.0, hrg::est::readout_pattern_sigmas(inconsistent), 0.0);
+  PickoffSelfCalResult refused = r;
+  refused.status = Status::ill_conditioned;
+  DOUBLES_EQUAL(0.0, hrg::est::readout_pattern_sigmas(refused), 0.0);
+}
+
 TEST(PickoffSelfCalibration, AppliedAndIdentifiedAgainTheResidualMapVanishes) {
   // The firmware applies the identified inverse and keeps identifying on the
   // corrected signals: what is left is within the noise.

@@ -85,6 +85,7 @@ class FakeResonatorIdentifier final : public fw::ResonatorIdentifier {
   fw::EstimatorHealth health() const override { return health_; }
   fw::Identification identification() const override { return {}; }
   double drift_rad_s(double, double, double) const override { return drift; }
+  double control_drift_rad_s(const fw::ChainRecord&) override { return control_drift; }
   void set_temperature_c(double t_c, bool valid) override {
     temp_c = t_c;
     temp_valid = valid;
@@ -93,6 +94,7 @@ class FakeResonatorIdentifier final : public fw::ResonatorIdentifier {
 
   fw::EstimatorHealth health_{};
   double drift = 0.0;
+  double control_drift = 0.0;  // D_Phi, rad/s
   uint32_t begun = 0, ended = 0, aborted = 0, samples = 0, solves = 0, temperatures = 0;
   double last_begin_s = 0.0;
   double temp_c = 0.0;

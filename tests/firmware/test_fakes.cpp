@@ -127,4 +127,6 @@ TEST(FakeResonatorIdentifier, CountsWindowsSamplesOnlyInsideAWindowAndReportsIts
   id.health_ = {true, 12.0, 0.5};
   DOUBLES_EQUAL(3e-4, id.drift_rad_s(0.1, 0.0, 1.0), 0.0);
   DOUBLES_EQUAL(12.0, id.health().condition, 0.0);
+  id.control_drift = -2e-5;
+  DOUBLES_EQUAL(-2e-5, id.control_drift_rad_s(s), 0.0);
 }

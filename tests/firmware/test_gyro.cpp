@@ -346,3 +346,59 @@ TEST(Gyro, ReadsTheTemperatureSensorAt100HzAndPassesItToTheIdentifierAndTelemetr
   CHECK(g.status().temp_valid);
   DOUBLES_EQUAL(27.0, ident.temp_c, 0.0);
 }
+
+TEST(Gyro, TheReadoutsOwnPatternWithholdsDPhiAndTheStatusSaysWhy) {
+  using hrg::fw::CompensationReason;
+  using hrg::fw::reason_bit;
+  auto cfg = test_config();
+  cfg.identify = false;  // a model from calibration: in force once solved, no check windows
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  ident.control_drift = 2e-4;  // rad/s: what the D_Phi fits read
+  CHECK(run_until(g, Mode::operate) > 0);
+  // GIVEN no model yet: not valid, because not in force
+  LONGS_EQUAL(reason_bit(CompensationReason::not_in_force), g.status().compensation_reasons);
+  // WHEN the model is solved and the readout shows no pattern
+  ident.health_.solved = true;
+  ident.health_.readout_pattern_sigmas = 4.9;
+  run(g, 100);
+  // THEN D_Phi is added and the compensation is valid with no reason against it
+  DOUBLES_EQUAL(2e-4, g.status().control_drift_rad_s, 0.0);
+  DOUBLES_EQUAL(0.0, g.status().control_drift_withheld_rad_s, 0.0);
+  CHECK(g.status().compensation_valid);
+  LONGS_EQUAL(0, g.status().compensation_reasons);
+  // WHEN the pickoff self-identification's gain stands 5.1 sigmas out
+  ident.health_.readout_pattern_sigmas = 5.1;
+  run(g, 100);
+  // THEN D_Phi is withheld and said so; with no pump D_Phi in use nothing
+  // measured is missing, so the compensation stays valid
+  const uint8_t withheld = reason_bit(CompensationReason::control_drift_withheld);
+  DOUBLES_EQUAL(0.0, g.status().control_drift_rad_s, 0.0);
+  DOUBLES_EQUAL(2e-4, g.status().control_drift_withheld_rad_s, 0.0);
+  LONGS_EQUAL(withheld, g.status().compensation_reasons);
+  CHECK(g.status().compensation_valid);
+  // WHEN the pump's D_Phi was in use: the output misses it, not valid
+  ident.health_.pump_drift_in_use = true;
+  run(g, 100);
+  CHECK_FALSE(g.status().compensation_valid);
+  LONGS_EQUAL(withheld, g.status().compensation_reasons);
+  // WHEN instead the model's damping anisotropy is the readout's (6.5 sigmas)
+  ident.health_.pump_drift_in_use = false;
+  ident.health_.readout_pattern_sigmas = 0.0;
+  ident.health_.readout_damping_sigmas = 6.5;
+  run(g, 100);
+  // THEN not valid, both reasons, and the figure on the status and the bus
+  const uint8_t both = reason_bit(CompensationReason::readout_in_damping) | withheld;
+  CHECK_FALSE(g.status().compensation_valid);
+  LONGS_EQUAL(both, g.status().compensation_reasons);
+  DOUBLES_EQUAL(0.0, g.status().control_drift_rad_s, 0.0);
+  DOUBLES_EQUAL(6.5, g.status().readout_damping_sigmas, 0.0);
+  LONGS_EQUAL(both, g.telemetry().comp_reasons);
+  DOUBLES_EQUAL(6.5, g.telemetry().readout_damping_sigmas, 0.0);
+  CHECK_FALSE(g.telemetry().comp_valid);
+  // WHEN both figures fall back within their limits, D_Phi is added again
+  ident.health_.readout_damping_sigmas = 4.0;
+  run(g, 100);
+  DOUBLES_EQUAL(2e-4, g.status().control_drift_rad_s, 0.0);
+  LONGS_EQUAL(0, g.status().compensation_reasons);
+  CHECK(g.status().compensation_valid);
+}

@@ -39,6 +39,10 @@ TelemetrySnapshot sample(int k) {
   s.pll_freq_hz = 4999.87310 + 1e-4 * k;
   s.angular_gain = 0.554;
   s.mode = hrg::fw::Mode::operate;
+  // The compensation: not checked yet, then the model check against the
+  // readout's pattern trips from frame 1000 on (12.5 sigmas, D_Phi withheld).
+  s.comp_reasons = k < 1000 ? 4 : 32 + 64;
+  s.readout_damping_sigmas = k < 1000 ? 0.0 : 12.5;
   // The firmware's readings: one more edge every 100 ms.
   FirmwareEstimates& e = s.estimates;
   e.feedthrough = true;
@@ -141,6 +145,19 @@ TEST(CanDecode, RowsAreTheTransmittedSamplesAndLossesAreCountedPerMessage) {
   }
   // AND the missing samples show as gaps, never filled in
   CHECK(rec.gaps().size() >= 2);
+  // AND the compensation's health is the latest HRG_STATUS (10 Hz) and
+  // HRG_EST_QUALITY (2 Hz: frames 492, 992, 1492, ...) before the row
+  for (std::size_t r = 0; r < rec.rows(); ++r) {
+    const int k = static_cast<int>(std::lround((t[r] - 0.1 + 2.5e-3) * 1e3));
+    DOUBLES_EQUAL(0, rec.column("comp_valid")[r], 0);
+    if (k >= 500 && k < 990) {
+      DOUBLES_EQUAL(4, rec.column("comp_reasons")[r], 0);
+      DOUBLES_EQUAL(0, rec.column("readout_damping_sigmas")[r], 0);
+    } else if (k >= 1500) {
+      DOUBLES_EQUAL(32 + 64, rec.column("comp_reasons")[r], 0);
+      DOUBLES_EQUAL(12.5, rec.column("readout_damping_sigmas")[r], 0);
+    }
+  }
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
 }

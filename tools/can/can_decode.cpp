@@ -30,7 +30,16 @@ struct Layout {
   const DbcMessage* info;
   const DbcMessage* lab_table;
   const DbcMessage* cal_readings;  // nullptr in a DBC before protocol 3
+  const DbcMessage* est_quality;
+  // The compensation's health (HRG_STATUS.comp_reasons,
+  // HRG_EST_QUALITY.readout_damping_sigmas): false in a DBC before protocol 4.
+  bool health;
 };
+
+bool has_health(const DbcMessage& status, const DbcMessage* quality) {
+  return status.signal("comp_reasons") != nullptr && quality != nullptr &&
+         quality->signal("readout_damping_sigmas") != nullptr;
+}
 
 const DbcMessage& need(const Dbc& dbc, std::string_view name, const std::string& path) {
   const DbcMessage* m = dbc.message(name);
@@ -149,6 +158,7 @@ struct PendingRow {
 // The slower messages' latest values.
 struct Latest {
   double temp_c = 0, mode = 0, pll_hz = 0, rate_dps = 0;
+  double comp_valid = 0, comp_reasons = 0, readout_damping_sigmas = 0;
 };
 
 void take_latest(const Layout& L, const DbcMessage* m, const hal::CanFrame& f, bool lab_temp,
@@ -156,7 +166,13 @@ void take_latest(const Layout& L, const DbcMessage* m, const hal::CanFrame& f, b
   if (m == L.status) {
     if (!lab_temp) v.temp_c = value(*m, "temp_c", f);
     v.mode = value(*m, "mode", f);
+    if (L.health) {
+      v.comp_valid = value(*m, "comp_valid", f);
+      v.comp_reasons = value(*m, "comp_reasons", f);
+    }
   }
+  if (m == L.est_quality && L.health)
+    v.readout_damping_sigmas = value(*m, "readout_damping_sigmas", f);
   if (m == L.loops) v.pll_hz = value(*m, "pll_freq_hz", f);
   if (m == L.lab_table) {
     v.rate_dps = value(*m, "rate_dps", f);
@@ -213,6 +229,7 @@ void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
         t,        p.cx,   p.sx,      p.cy,    p.sy, value(*m, "exc", f), value(*m, "pump_v", f),
         v.temp_c, v.mode, p.exc_cmd, v.pll_hz};
     if (sum.has_lab_table) row.push_back(v.rate_dps);
+    if (L.health) row.insert(row.end(), {v.comp_valid, v.comp_reasons, v.readout_damping_sigmas});
     writer.write_row(row);
     ++sum.rows;
   });
@@ -223,17 +240,23 @@ void write_rows(const CanDecodeOptions& o, const Dbc& dbc, const Layout& L,
 CanDecodeSummary can_decode(const CanDecodeOptions& o) {
   const std::string dbc_path = o.dbc_path.empty() ? std::string(HRG_DEFAULT_DBC) : o.dbc_path;
   const Dbc dbc = load_dbc(dbc_path);
+  const DbcMessage& status = need(dbc, "HRG_STATUS", dbc_path);
+  const DbcMessage* quality = dbc.message("HRG_EST_QUALITY");
   const Layout L{&need(dbc, "HRG_WAVE_X", dbc_path), &need(dbc, "HRG_WAVE_Y", dbc_path),
                  &need(dbc, "HRG_ROW", dbc_path),    &need(dbc, "HRG_REFERENCE", dbc_path),
-                 &need(dbc, "HRG_LOOPS", dbc_path),  &need(dbc, "HRG_STATUS", dbc_path),
+                 &need(dbc, "HRG_LOOPS", dbc_path),  &status,
                  &need(dbc, "HRG_INFO", dbc_path),   dbc.message("LAB_TABLE"),
-                 dbc.message("HRG_CAL_READINGS")};
+                 dbc.message("HRG_CAL_READINGS"),    quality,
+                 has_health(status, quality)};
   CanDecodeSummary sum;
   sum.bitrate_bps = dbc.bitrate_bps;
   scan_log(o, dbc, L, sum);
   std::vector<std::string> columns = {"t_s",    "cx_v",   "sx_v", "cy_v",    "sy_v",  "exc",
                                       "pump_v", "temp_c", "mode", "exc_cmd", "pll_hz"};
   if (sum.has_lab_table) columns.emplace_back("rate_dps");
+  // The columns hrg sim's telemetry.csv gives them.
+  if (L.health)
+    columns.insert(columns.end(), {"comp_valid", "comp_reasons", "readout_damping_sigmas"});
   recording::RecordingWriter writer(o.out_path, columns, sum.f_ref_hz, sum.angular_gain,
                                     recording_metadata(o, dbc_path, sum));
   write_rows(o, dbc, L, writer, sum);
@@ -295,11 +318,13 @@ int can_decode_main(std::span<char* const> args) {
     std::fprintf(stderr,
                  "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
                  "[--f-ref-hz F]\n"
-                 "Turns a candump -l log of HRG telemetry (protocol 2 or 3) into an hrg-recording\n"
-                 "v1 that hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s,\n"
-                 "the drive as applied, rate and temperature from the bench's LAB_TABLE, the\n"
-                 "firmware's readings of HRG_CAL_READINGS as header keys), and reports the\n"
-                 "frames lost (from each message's sequence counter) and the bus load.\n");
+                 "Turns a candump -l log of HRG telemetry (protocol 2 to 4; a log of an earlier\n"
+                 "protocol than the DBC's with that protocol's DBC) into an hrg-recording v1 that\n"
+                 "hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s, the\n"
+                 "drive as applied, rate and temperature from the bench's LAB_TABLE, the\n"
+                 "firmware's readings of HRG_CAL_READINGS as header keys, the compensation's\n"
+                 "comp_valid, comp_reasons and readout_damping_sigmas), and reports the frames\n"
+                 "lost (from each message's sequence counter) and the bus load.\n");
     return 2;
   };
   for (std::size_t i = 0; i < args.size(); ++i) {

@@ -54,7 +54,10 @@ struct CanDecodeSummary {
 // f_ref_hz) at the firmware's row time, exc the drive as applied, pump_v of
 // the same block; rate_dps and temp_c from the latest LAB_TABLE when the log
 // has any (else temp_c from HRG_STATUS and no rate); mode, exc_cmd (the
-// excitation command) and pll_hz the latest values. Losses are counted per
+// excitation command) and pll_hz the latest values, and with a DBC of
+// protocol 4 the compensation's comp_valid, comp_reasons (HRG_STATUS) and
+// readout_damping_sigmas (HRG_EST_QUALITY), the columns hrg sim's
+// telemetry.csv has. Losses are counted per
 // message from the sequence counters and written to the metadata. The
 // firmware's own readings (HRG_CAL_READINGS, last complete set) become the
 // header keys hrg sim writes (can/estimates_header.hpp); none without a

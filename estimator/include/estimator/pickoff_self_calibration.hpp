@@ -190,4 +190,11 @@ class PickoffSelfCalibration {
 double damping_anisotropy_disagreement_sigmas(const PickoffSelfCalResult& r, const ParamVector& p,
                                               double sigma_dnu_c_per_s, double sigma_dnu_s_per_s);
 
+// How many of its own standard errors the readout's level pattern stands
+// from none: the larger of |g| / sigma_g and |b| / sigma_b (the pickoff gain
+// and misalignment, the two that put a 4 theta pattern into the measured
+// amplitude; the phase lag reads as a split instead). 0 under the same
+// conditions as above (solve not ok, or more than one decay rate).
+double readout_pattern_sigmas(const PickoffSelfCalResult& r);
+
 }  // namespace hrg::est

@@ -52,6 +52,8 @@ constexpr SignalDef kStatus[] = {
   {"faults", 16, 16, false, 1, 0, 0, 65535, ""},
   {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
   {"seq", 48, 8, false, 1, 0, 0, 255, ""},
+  // fw::CompensationReason bits (compensation_reason.hpp): 7 used.
+  {"comp_reasons", 56, 8, false, 1, 0, 0, 127, ""},
 };
 constexpr SignalDef kEstDamping[] = {
   {"nu_per_s", 0, 24, false, 1e-8, 0, 0, 16777215.0 * 1e-8, "1/s"},
@@ -70,6 +72,8 @@ constexpr SignalDef kEstQuality[] = {
   {"windows", 32, 16, false, 1, 0, 0, 65535, ""},
   {"valid", 48, 1, false, 1, 0, 0, 1, ""},
   {"seq", 56, 8, false, 1, 0, 0, 255, ""},
+  // Standard errors (the firmware's limit is 5): 0.5 resolution, saturates at 63.5.
+  {"readout_damping_sigmas", 49, 7, false, 0.5, 0, 0, 63.5, ""},
 };
 constexpr SignalDef kExec[] = {
   {"overruns", 0, 16, false, 1, 0, 0, 65535, ""},
@@ -251,7 +255,7 @@ const std::array<MessageDef, kTelemetryCount> kTelemetry = {{
   {"HRG_ANGLE",       0x102, 7, 500, "HRG", kAngle},
   {"HRG_LOOPS",       0x103, 8, 100, "HRG", kLoops},
   {"HRG_PUMP",        0x104, 7, 100, "HRG", kPump},
-  {"HRG_STATUS",      0x105, 7,  10, "HRG", kStatus},
+  {"HRG_STATUS",      0x105, 8,  10, "HRG", kStatus},
   {"HRG_EST_DAMPING", 0x106, 8,   2, "HRG", kEstDamping},
   {"HRG_EST_SPLIT",   0x107, 7,   2, "HRG", kEstSplit},
   {"HRG_EST_QUALITY", 0x108, 8,   2, "HRG", kEstQuality},
@@ -286,11 +290,11 @@ const std::array<MessageDef, kCalibrationMessageCount> kCalibrationMessages = {{
 // clang-format on
 
 static_assert(fits(kWaveX, 8) && fits(kWaveY, 8) && fits(kAngle, 7) && fits(kLoops, 8) &&
-              fits(kPump, 7) && fits(kStatus, 7) && fits(kEstDamping, 8) && fits(kEstSplit, 7) &&
+              fits(kPump, 7) && fits(kStatus, 8) && fits(kEstDamping, 8) && fits(kEstSplit, 7) &&
               fits(kEstQuality, 8) && fits(kExec, 8) && fits(kInfo, 8) && fits(kCanStats, 8) &&
               fits(kRow, 8) && fits(kReference, 5) && fits(kLabTableSignals, 7) &&
               fits(kCalReadings, 8));
-static_assert(disjoint(kStatus) && disjoint(kCalReadings));
+static_assert(disjoint(kStatus) && disjoint(kEstQuality) && disjoint(kCalReadings));
 static_assert(fits(kSetMode, 3) && fits(kIdent, 3) && fits(kWindow, 6) && fits(kAgc, 4) &&
               fits(kStatusRequest, 2) && fits(kReplySignals, 4));
 static_assert(fits(kCalSeedRequest, 1) && fits(kCalKey, 5) && fits(kCalStart, 7) &&

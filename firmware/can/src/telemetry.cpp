@@ -85,6 +85,7 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::cal_gap_refuted, b(s.cal_gap_refuted), f);
       put(m, sig::faults, s.faults, f);
       put(m, sig::temp_c, s.temp_c, f);
+      put(m, sig::comp_reasons, s.comp_reasons, f);
       break;
     case Tm::est_damping:
       put(m, sig::nu_per_s, s.nu_per_s, f);
@@ -100,6 +101,7 @@ void encode_telemetry(Tm message, const TelemetrySnapshot& s, uint8_t seq, hal::
       put(m, sig::coverage, s.coverage, f);
       put(m, sig::windows, sat_u(s.windows, 65535), f);
       put(m, sig::est_valid, b(s.est_valid), f);
+      put(m, sig::readout_damping_sigmas, s.readout_damping_sigmas, f);
       break;
     case Tm::exec:
       put(m, sig::overruns, sat_u(s.overruns, 65535), f);

@@ -25,6 +25,14 @@ struct EstimatorHealth {
   // has nothing to say): large when the model took a readout pattern for
   // damping.
   double readout_damping_sigmas = 0.0;
+  // Standard errors the pickoff self-identification's gain or misalignment
+  // (the larger) stands from zero (est::readout_pattern_sigmas; 0 under
+  // the same conditions): the readout's own 4 theta pattern in the measured
+  // amplitude, which the D_Phi fits would read as drift.
+  double readout_pattern_sigmas = 0.0;
+  // The pump's part of D_Phi is in use (its online fit usable, or a known
+  // gap standing in for it): withholding D_Phi then withholds a drift.
+  bool pump_drift_in_use = false;
 };
 
 }  // namespace hrg::fw

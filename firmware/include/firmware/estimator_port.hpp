@@ -27,6 +27,8 @@ class EstimatorPort final : public ResonatorIdentifier {
     EstimatorHealth h = health_;
     h.control_drift_lost = est_.pump_drift_lost();
     h.readout_damping_sigmas = readout_damping_sigmas();
+    h.readout_pattern_sigmas = est::readout_pattern_sigmas(self_cal_result_);
+    h.pump_drift_in_use = est_.pump_drift().usable() || est_.known_gap_in_use();
     return h;
   }
   Identification identification() const override;

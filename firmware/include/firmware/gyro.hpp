@@ -9,6 +9,7 @@
 #include "firmware/can/envelope_reference.hpp"
 #include "firmware/can/link.hpp"
 #include "firmware/can/telemetry.hpp"
+#include "firmware/compensation_reason.hpp"
 #include "firmware/executive.hpp"
 #include "firmware/fault_monitor.hpp"
 #include "firmware/mode.hpp"
@@ -55,6 +56,15 @@ struct GyroConfig {
   // same identification before it applies it (fw::app::Firmware::
   // kSelfCalSignificance). 0: not checked.
   double max_readout_damping_sigmas = 5.0;
+  // D_Phi is not applied while the readout's own 4 theta pattern explains
+  // what its fits read: the check above trips, or the pickoff
+  // self-identification's gain or misalignment stands more than this many
+  // standard errors from zero (EstimatorHealth::readout_pattern_sigmas). A
+  // gain g reads the amplitude as a (1 + g sin^2 2theta): its level pattern,
+  // seen while the table turns, is a 4 theta rate in ln a that the pump's
+  // fit takes for a gap harmonic (0.18-0.36 at g 0.01 on the 4.2 kHz
+  // resonator of tools/gregory/README.md). 0: not checked.
+  double max_readout_pattern_sigmas = 5.0;
   // Do no harm while the pump runs: the step of the corrected signal at
   // every switch-off (PumpEdgeCheck). A step above its tolerance makes the
   // compensation not valid.
@@ -83,6 +93,9 @@ struct GyroStatus {
   double out_rate_rad_s = 0.0;
   double drift_rad_s = 0.0;          // D used for the correction (Omega K units)
   double control_drift_rad_s = 0.0;  // its control-loop part D_Phi
+  // The D_Phi the estimator gave and the firmware did not apply
+  // (CompensationReason::control_drift_withheld), rad/s; 0 otherwise.
+  double control_drift_withheld_rad_s = 0.0;
   bool out_valid = false;
   // The drift compensation is in force: the campaign has ended and no check
   // window has disagreed with its model (false for good after one did).
@@ -91,6 +104,11 @@ struct GyroStatus {
   // step of the corrected signal (pump_edge): the compensated output is one
   // the firmware stands behind.
   bool compensation_valid = false;
+  // Why not (CompensationReason bits; 0 when valid), and the model check
+  // against the readout's pattern behind one of them
+  // (EstimatorHealth::readout_damping_sigmas), both from check_model().
+  uint8_t compensation_reasons = reason_bit(CompensationReason::not_in_force);
+  double readout_damping_sigmas = 0.0;
   PumpEdgeStatus pump_edge{};
   uint32_t model_checks_failed = 0;
   uint32_t adc_errors = 0;
@@ -236,6 +254,7 @@ class Gyro {
   uint32_t pattern_hold_frames_ = 0;
   bool host_pattern_ = false;
   bool compensation_ready_ = false;
+  bool control_drift_withheld_ = false;  // check_model(): D_Phi not applied
   uint32_t checks_seen_ = 0;
   uint32_t checks_passed_ = 0;
   uint32_t failed_before_restart_ = 0;  // model_checks_failed when the campaign restarted

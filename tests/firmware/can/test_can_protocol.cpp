@@ -132,6 +132,8 @@ TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
   s.faults = static_cast<uint16_t>(hrg::fw::fault_bit(hrg::fw::Fault::adc_stuck) |
                                    hrg::fw::fault_bit(hrg::fw::Fault::external));
   s.temp_c = 32.26;
+  s.comp_reasons = 32 + 64;  // readout_in_damping, control_drift_withheld
+  s.readout_damping_sigmas = 22.4;
   s.nu_per_s = 3.14159e-3;
   s.dnu_c_per_s = 1.57e-4;
   s.dnu_s_per_s = -2.3e-5;
@@ -184,6 +186,7 @@ TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
       {Tm::status, "cal_gap_refuted", 0},
       {Tm::status, "faults", 8 + 64},
       {Tm::status, "temp_c", 32.26},
+      {Tm::status, "comp_reasons", 32 + 64},
       {Tm::est_damping, "nu_per_s", 3.14159e-3},
       {Tm::est_damping, "dnu_c_per_s", 1.57e-4},
       {Tm::est_damping, "dnu_s_per_s", -2.3e-5},
@@ -193,6 +196,7 @@ TEST(Telemetry, SnapshotFieldsLandInTheirSignals) {
       {Tm::est_quality, "coverage", 0.875},
       {Tm::est_quality, "windows", 42},
       {Tm::est_quality, "valid", 1},
+      {Tm::est_quality, "readout_damping_sigmas", 22.4},
       {Tm::exec, "overruns", 65535},
       {Tm::exec, "missed_ticks", 3},
       {Tm::exec, "max_frame_us", 612},
@@ -332,13 +336,13 @@ TEST(Telemetry, DefaultBusLoadIsTheSumOfRateTimesWorstCaseFrameBits) {
   LONGS_EQUAL(125, worst_case_frame_bits(7));
   LONGS_EQUAL(105, worst_case_frame_bits(5));
   // angle (7 B) at 500 Hz; wave x, y, row and loops (8 B), pump (7 B) at 100 Hz;
-  // status (7 B), exec and cal readings (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info,
+  // status, exec and cal readings (8 B) at 10 Hz; estimator 8+7+8 B at 2 Hz; info,
   // can stats (8 B) and reference (5 B) at 1 Hz.
   const double bits = 500.0 * 125 + 100.0 * (135 + 135 + 135 + 135 + 125) +
-                      10.0 * (125 + 135 + 135) + 2.0 * (135 + 125 + 135) + 1.0 * (135 + 135 + 105);
+                      10.0 * (135 + 135 + 135) + 2.0 * (135 + 125 + 135) + 1.0 * (135 + 135 + 105);
   const double load = bus_load_fraction(TelemetryConfig::defaults(), kBitrateBps);
   DOUBLES_EQUAL(bits / 1e6, load, 1e-12);
-  DOUBLES_EQUAL(0.134115, load, 1e-6);
+  DOUBLES_EQUAL(0.134215, load, 1e-6);
   CHECK(load < 0.5);
 }
 

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "can/estimates_header.hpp"
+#include "firmware/compensation_reason.hpp"
 #include "recording/recording.hpp"
 #include "recording/recording_writer.hpp"
 #include "sim_run/console.hpp"
@@ -309,6 +310,38 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.end_object();
 }
 
+// The names of the set bits of fw::CompensationReason (none: valid).
+std::string compensation_reason_text(uint8_t bits) {
+  std::string s;
+  for (int i = 0; i < fw::kCompensationReasonBits; ++i) {
+    if ((bits >> i & 1u) == 0) continue;
+    s += (s.empty() ? "" : ", ") + std::string(fw::kCompensationReasonNames[i]);
+  }
+  return s.empty() ? std::string("none") : s;
+}
+
+// Why the compensation is not valid at the end, the model check against the
+// readout's pattern, and D_Phi: whether it stood (not withheld), what was
+// added and withheld, and the pump fit's gap harmonic behind it.
+void compensation_health_json(JsonWriter& w, const RunResult& r) {
+  w.integer("reason_bits", r.compensation_reasons);
+  w.begin_array("reasons");
+  for (int i = 0; i < fw::kCompensationReasonBits; ++i)
+    if ((r.compensation_reasons >> i & 1u) != 0) w.string({}, fw::kCompensationReasonNames[i]);
+  w.end_array();
+  w.number("readout_damping_sigmas", r.readout_damping_sigmas);
+  w.number("readout_pattern_sigmas", r.readout_pattern_sigmas);
+  w.begin_object("control_drift");
+  const auto withheld = fw::reason_bit(fw::CompensationReason::control_drift_withheld);
+  w.boolean("valid", (r.compensation_reasons & withheld) == 0);
+  w.number("applied_mean_dph", r.control_drift_mean_dph);
+  w.number("withheld_mean_dph", r.control_drift_withheld_mean_dph);
+  w.boolean("pump_fit_usable", r.pump_drift_usable);
+  w.number("pump_gap", r.pump_gap);
+  w.number("pump_gap_sigmas", r.pump_gap_sigmas);
+  w.end_object();
+}
+
 void drift_json(JsonWriter& w, const RunResult& r) {
   w.begin_object("drift");
   bias_json(w, "raw", r.fit_raw);
@@ -438,6 +471,7 @@ std::string report_json(const RunConfig& job, const RunResult& r) {
   w.boolean("applied", r.compensation_applied);
   w.integer("model_checks_failed", r.model_checks_failed);
   w.number("last_window_misfit", r.last_window_misfit);
+  compensation_health_json(w, r);
   // The calibration in force (CRC-32 of its canonical form, as hrg
   // calibration-check prints it; that of the identity when none was given).
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
@@ -484,7 +518,9 @@ const std::vector<std::string>& telemetry_columns() {
                                              "pattern_cmd",
                                              "comp_valid",
                                              "raw_error_deg",
-                                             "out_error_deg"};
+                                             "out_error_deg",
+                                             "comp_reasons",
+                                             "readout_damping_sigmas"};
   return cols;
 }
 
@@ -515,7 +551,9 @@ void telemetry_values(const TelemetryRow& row, std::vector<double>& v) {
        double(row.pattern_cmd),
        double(row.comp_valid),
        row.raw_error_deg,
-       row.out_error_deg};
+       row.out_error_deg,
+       double(row.comp_reasons),
+       row.readout_damping_sigmas};
 }
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
@@ -670,7 +708,11 @@ void print_summary(std::FILE* out, const RunConfig& job, const RunResult& r) {
   add("drift model (truth)", r.fit_model);
   bias.row({"parked angles", fmt("%zu (compensated fit over the %zu with the model valid)",
                                  r.parks.size(), r.parks_model_valid)});
-  bias.row({"control-loop drift", fmt("%+.3f", r.control_drift_mean_dph), "(mean D_Phi/K added)"});
+  bias.row({"control-loop drift", fmt("%+.3f", r.control_drift_mean_dph), "(mean D_Phi/K added)",
+            fmt("%+.3f withheld", r.control_drift_withheld_mean_dph)});
+  bias.row({"compensation", r.compensation_valid ? "valid" : "not valid",
+            "why not: " + compensation_reason_text(r.compensation_reasons),
+            fmt("readout check %.1f sigma", r.readout_damping_sigmas)});
   bias.print(out);
   if (r.fit_comp.degenerate())
     std::fprintf(out, "  bias test: %s\n", degenerate_parks_note(r.fit_comp).c_str());

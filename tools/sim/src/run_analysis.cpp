@@ -24,7 +24,7 @@ void accumulate_errors(RunResult& r, const RunConfig& job) {
   std::size_t n = 0;
   const double dt_h = 1.0 / job.telemetry_hz / 3600.0;
   double model_deg = 0, bound_deg = 0, raw_err = 0, out_err = 0;
-  double control_sum = 0;
+  double control_sum = 0, withheld_sum = 0;
   std::size_t control_n = 0;
   const TelemetryRow* prev = nullptr;
   for (TelemetryRow& row : r.rows) {
@@ -39,6 +39,7 @@ void accumulate_errors(RunResult& r, const RunConfig& job) {
     if (!row.out_valid) continue;
     if (row.t_s >= r.t_operate_s) {
       control_sum += row.drift_control_dph;
+      withheld_sum += row.drift_withheld_dph;
       ++control_n;
     }
     model_deg -= row.drift_true_dph * dt_h;
@@ -50,6 +51,8 @@ void accumulate_errors(RunResult& r, const RunConfig& job) {
   }
   r.tracking_rms_deg = n ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
   r.control_drift_mean_dph = control_n ? control_sum / static_cast<double>(control_n) : 0.0;
+  r.control_drift_withheld_mean_dph =
+      control_n ? withheld_sum / static_cast<double>(control_n) : 0.0;
   r.model_error_end_deg = model_deg;
   r.drift_bound_deg = bound_deg;
   r.raw_error_end_deg = raw_err;

@@ -250,12 +250,15 @@ void record_row(RunResult& r, const RunConfig& job, const fw::Gyro& g, const Row
   row.a_B_v = ch.wave.a_B_v;
   row.drift_model_dph = st.drift_rad_s / k * kRadSToDph;
   row.drift_control_dph = st.control_drift_rad_s / k * kRadSToDph;
+  row.drift_withheld_dph = st.control_drift_withheld_rad_s / k * kRadSToDph;
   const double q = ts.a_A_v > 0 ? ts.a_B_v / ts.a_A_v : 0.0;
   row.drift_true_dph =
       true_drift_rad_s(job.sim.resonator, ts.pattern_angle_rad, q) / k * kRadSToDph;
   row.out_valid = st.out_valid ? 1 : 0;
   row.pattern_cmd = st.pattern_control ? 1 : 0;
   row.comp_valid = st.compensation_valid ? 1 : 0;
+  row.comp_reasons = st.compensation_reasons;
+  row.readout_damping_sigmas = st.readout_damping_sigmas;
   r.rows.push_back(row);
 }
 
@@ -465,7 +468,15 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.compensation_valid = gyro.status().compensation_valid;
   r.compensation_applied = gyro.status().compensation_applied;
   r.model_checks_failed = gyro.status().model_checks_failed;
-  r.last_window_misfit = firmware->estimator().health().window_misfit;
+  const fw::EstimatorHealth health = firmware->estimator().health();
+  r.last_window_misfit = health.window_misfit;
+  r.compensation_reasons = gyro.status().compensation_reasons;
+  r.readout_damping_sigmas = gyro.status().readout_damping_sigmas;
+  r.readout_pattern_sigmas = health.readout_pattern_sigmas;
+  const est::PumpDriftEstimator& pump = firmware->estimator().estimator().pump_drift();
+  r.pump_gap = pump.gap();
+  r.pump_gap_sigmas = pump.gap_sigmas();
+  r.pump_drift_usable = pump.usable();
   r.calibration = firmware->calibration_status();
   r.self_calibration = firmware->estimator().pickoff_self_calibration();
   r.self_calibration_applied = firmware->self_calibration();

@@ -93,10 +93,13 @@ struct TelemetryRow {
   int mode;
   double theta_deg, out_angle_deg, raw_angle_deg, true_angle_deg, true_theta_deg;
   double a_A_v, a_B_v, drift_model_dph, drift_true_dph;
-  double drift_control_dph;  // the control-loop part of drift_model_dph
+  double drift_control_dph;   // the control-loop part of drift_model_dph
+  double drift_withheld_dph;  // the D_Phi/K the firmware did not apply (readout pattern)
   int out_valid;
-  int pattern_cmd;  // the pattern is being moved on purpose
-  int comp_valid;   // the drift compensation is in force (its model checks agree)
+  int pattern_cmd;                // the pattern is being moved on purpose
+  int comp_valid;                 // the drift compensation is in force (its model checks agree)
+  int comp_reasons;               // why not: fw::CompensationReason bits (0 when valid)
+  double readout_damping_sigmas;  // the model check against the readout's pattern
   // Output minus truth, accumulated only between consecutive rows with a
   // valid output (a held output while the pattern is moved on purpose does
   // not count as an error), deg.
@@ -179,12 +182,23 @@ struct RunResult {
   double noise_sigma_v = 0.0;
   double t_converged_s = -1.0;          // the window campaign ended (model applied)
   double control_drift_mean_dph = 0.0;  // mean D_Phi/K added over the valid output
+  // ... and withheld (the readout's pattern explained what D_Phi's fits read).
+  double control_drift_withheld_mean_dph = 0.0;
   // Do no harm: the compensation in force at the end (its model checks
   // agreed), the failed checks, the last check window's misfit.
   bool compensation_valid = false;
   bool compensation_applied = false;
   uint32_t model_checks_failed = 0;
   double last_window_misfit = 0.0;
+  // Why not valid at the end (fw::CompensationReason bits), the model check
+  // against the readout's pattern, the readout pattern's own significance,
+  // and the pump's D_Phi fit (its gap harmonic, how many sigmas, usable).
+  uint8_t compensation_reasons = 0;
+  double readout_damping_sigmas = 0.0;
+  double readout_pattern_sigmas = 0.0;
+  double pump_gap = 0.0;
+  double pump_gap_sigmas = 0.0;
+  bool pump_drift_usable = false;
   // The calibration's trial (source, verdict, the misfits that judged it).
   fw::app::CalibrationStatus calibration{};
   // The firmware's pickoff self-calibration at the end (its last solve).

@@ -23,7 +23,10 @@ namespace hrg::fw::can {
 // 2: HRG_WAVE_X/Y against the fixed reference of HRG_REFERENCE, HRG_ROW.
 // 3: HRG_CAL_READINGS, the firmware's own readings for a calibration file (a
 //    log of protocol 3 without them holds none, one of 2 cannot).
-inline constexpr uint8_t kProtocolVersion = 3;
+// 4: why the compensation is not valid (HRG_STATUS.comp_reasons, DLC 7 -> 8)
+//    and the model check against the readout's pattern
+//    (HRG_EST_QUALITY.readout_damping_sigmas).
+inline constexpr uint8_t kProtocolVersion = 4;
 inline constexpr uint32_t kBitrateBps = 1'000'000;
 
 // Telemetry messages, in table order (index into kTelemetry).
@@ -98,11 +101,19 @@ enum Status : uint8_t {
   cal_gap_refuted,
   faults,
   temp_c,
-  status_seq
+  status_seq,
+  comp_reasons
 };
 enum EstDamping : uint8_t { nu_per_s, dnu_c_per_s, dnu_s_per_s, est_damping_seq };
 enum EstSplit : uint8_t { dw_c_rad_s, dw_s_rad_s, est_split_seq };
-enum EstQuality : uint8_t { cond_log10, coverage, windows, est_valid, est_quality_seq };
+enum EstQuality : uint8_t {
+  cond_log10,
+  coverage,
+  windows,
+  est_valid,
+  est_quality_seq,
+  readout_damping_sigmas
+};
 enum Exec : uint8_t { overruns, missed_ticks, max_frame_us, cpu_load_pct, exec_seq };
 enum Info : uint8_t { protocol_version, angular_gain, window_period_s, window_length_s, info_seq };
 enum CanStats : uint8_t {

@@ -40,6 +40,10 @@ struct TelemetrySnapshot {
   bool fault_input = false;   // board fault input
   bool ident_active = false;  // identification (window schedule) running
   bool comp_valid = false;    // the drift compensation is in force and its model checks agree
+  uint8_t comp_reasons = 0;   // why not: fw::CompensationReason bits (0 when valid)
+  // The model's damping anisotropy against the pickoff self-identification's
+  // (standard errors; fw::EstimatorHealth::readout_damping_sigmas).
+  double readout_damping_sigmas = 0;
   // Do no harm for a calibration: its correction of the pickoffs was
   // withdrawn, its damping model or its gap harmonic refuted (each taken out).
   bool cal_withdrawn = false;

@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: MIT
+// Do no harm, reported: why the compensation is not valid reaches the
+// report, the telemetry and the CAN bus from the one place the firmware
+// builds it (Gyro::check_model), and D_Phi is withheld where the readout's
+// own 4 theta pattern explains what its fits read.
+//
+// The 4.2 kHz resonator of tools/gregory/README.md with a 1 % y pickoff gain,
+// no calibration, 1800 s: the model takes the gain's level pattern, read
+// while the table turns, for damping anisotropy (22.7 standard errors from
+// the pickoff self-identification's), and the pump's D_Phi fit reads it as
+// a gap harmonic of 0.18-0.36 at 8-11 of its sigmas: -9.04 deg/h of mean
+// D_Phi/K added before. A real gap (eps_p 0.02, eps_q 0.01) leaves no pattern
+// in the free decays' level: its D_Phi stays applied.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "can/can_decode.hpp"
+#include "firmware/compensation_reason.hpp"
+#include "recording/recording.hpp"
+#include "sim_run/report.hpp"
+#include "sim_run/run.hpp"
+#include "sim_run/scenario_run.hpp"
+
+#include "support/default_scenario.hpp"
+#include "support/cpputest.hpp"
+
+TEST_GROUP_WITHOUT_LEAK_CHECK(Health);
+
+namespace {
+
+using hrg::fw::CompensationReason;
+using hrg::fw::reason_bit;
+using hrg::sim_run::RunConfig;
+using hrg::sim_run::RunResult;
+
+std::string source_dir() {
+  const char* src = std::getenv("HRG_SOURCE_DIR");
+  return src ? src : ".";
+}
+
+// tools/gregory/other-resonator.toml (4.2 kHz, Q 8e6, dmu 0.03 at 25 deg).
+RunConfig other_resonator(double duration_s) {
+  hrg::sim_run::ScheduleOptions o;
+  o.duration_s = duration_s;
+  return hrg::sim_run::run_from_scenario(source_dir() + "/tools/gregory/other-resonator.toml", o);
+}
+
+// A number of report.json's "compensation" object, by key.
+double report_number(const std::string& json, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const auto at = json.find(k, json.find("\"compensation\""));
+  CHECK_TEXT(at != std::string::npos, key.c_str());
+  return std::strtod(json.c_str() + at + k.size(), nullptr);
+}
+
+// The run's gap: D_Phi added, none withheld, nothing against the compensation.
+void check_gap_keeps_its_d_phi(RunConfig j) {
+  j.sim.electrodes.eps_p = 0.02;
+  j.sim.electrodes.eps_q = 0.01;
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
+  std::printf("\n  gap: D_Phi/K added %+.4f deg/h, withheld %+.4f, readout %.2f / %.2f sigma",
+              r.control_drift_mean_dph, r.control_drift_withheld_mean_dph, r.readout_damping_sigmas,
+              r.readout_pattern_sigmas);
+  // nu |eps| / 2 over K: about 1-2 deg/h of mean D_Phi/K on these resonators
+  CHECK(r.pump_drift_usable);
+  CHECK(r.control_drift_mean_dph > 0.5);
+  DOUBLES_EQUAL(0.0, r.control_drift_withheld_mean_dph, 0.0);
+  CHECK(r.compensation_valid);
+  LONGS_EQUAL(0, r.compensation_reasons);
+}
+
+}  // namespace
+
+TEST(Health, AGainTakenForDampingIsReportedWithItsFigureInTheReportTelemetryAndOnTheBus) {
+  // GIVEN the 1 % gain on the 4.2 kHz resonator, 1800 s, its CAN log kept
+  RunConfig j = other_resonator(1800.0);
+  j.sim.effects.pickoff_gain_mismatch.enabled = true;
+  j.sim.effects.pickoff_gain_mismatch.gain = 0.01;
+  hrg::sim_run::RunOptions opt;
+  opt.can_log = "test_e2e_health.log";
+  const RunResult r = hrg::sim_run::run_simulation(j, opt);
+  std::printf(
+      "\n  gain: readout %.2f sigma, reasons 0x%02x, D_Phi/K added %+.4f withheld %+.4f "
+      "deg/h, pump gap %.3f at %.1f sigma",
+      r.readout_damping_sigmas, r.compensation_reasons, r.control_drift_mean_dph,
+      r.control_drift_withheld_mean_dph, r.pump_gap, r.pump_gap_sigmas);
+  // THEN the check trips: the model's dnu_S 8.4e-5 1/s from the
+  // self-identification's, many times both sigmas (~4e-6)
+  const uint8_t want = reason_bit(CompensationReason::readout_in_damping) |
+                       reason_bit(CompensationReason::control_drift_withheld);
+  CHECK(r.readout_damping_sigmas > 2.0 * j.firmware.gyro.max_readout_damping_sigmas);
+  CHECK_FALSE(r.compensation_valid);
+  LONGS_EQUAL(want, r.compensation_reasons & want);
+  // AND D_Phi, its fit reading the gain as a gap harmonic, is withheld, not added
+  CHECK(r.pump_drift_usable);
+  DOUBLES_EQUAL(0.0, r.control_drift_mean_dph, 0.0);
+  CHECK(std::fabs(r.control_drift_withheld_mean_dph) > 1.0);
+  // AND report.json carries the figure and the reasons
+  const std::string json = hrg::sim_run::report_json(j, r);
+  DOUBLES_EQUAL(r.readout_damping_sigmas, report_number(json, "readout_damping_sigmas"), 1e-6);
+  LONGS_EQUAL(r.compensation_reasons, std::lround(report_number(json, "reason_bits")));
+  CHECK(json.find("\"readout_in_damping\"") != std::string::npos);
+  // AND the last telemetry row, and the CAN log decoded with the DBC, end on them
+  const hrg::recording::Recording tm = hrg::sim_run::telemetry_recording(j, r);
+  const std::size_t last = tm.rows() - 1;
+  DOUBLES_EQUAL(r.readout_damping_sigmas, tm.column("readout_damping_sigmas")[last], 1e-9);
+  DOUBLES_EQUAL(r.compensation_reasons, tm.column("comp_reasons")[last], 0.0);
+  hrg::can::CanDecodeOptions o;
+  o.log_path = opt.can_log;
+  o.out_path = "test_e2e_health.csv";
+  o.dbc_path = source_dir() + "/firmware/can/hrg.dbc";
+  (void)hrg::can::can_decode(o);
+  const hrg::recording::Recording bus = hrg::recording::read_recording(o.out_path);
+  const std::size_t end = bus.rows() - 1;
+  DOUBLES_EQUAL(r.readout_damping_sigmas, bus.column("readout_damping_sigmas")[end], 0.25);
+  DOUBLES_EQUAL(r.compensation_reasons, bus.column("comp_reasons")[end], 0.0);
+  DOUBLES_EQUAL(0.0, bus.column("comp_valid")[end], 0.0);
+  std::remove(opt.can_log.c_str());
+  std::remove(o.out_path.c_str());
+}
+
+TEST(Health, TheGapsDPhiStaysAppliedOnTheOtherResonator) {
+  check_gap_keeps_its_d_phi(other_resonator(0.0));
+}
+
+TEST(Health, TheGapsDPhiStaysAppliedOnTheDefaultScenario) {
+  check_gap_keeps_its_d_phi(hrg::test::default_scenario_run());
+}
