@@ -65,3 +65,32 @@ TEST(AuditSeveralEffects, ATripleOnTelemetryIsFoundWhole) {
   for (const auto& c : triple)
     check_finding(r, c, text);
 }
+
+TEST(AuditSeveralEffects, ADuffingTermBesideASpringAndAPhaseMismatchIsFound) {
+  // GIVEN the benchmark's triple of design 1 of `hrg audit-bench --seed 2026`
+  // (telemetry, reference fixed; values at 2x-3x the thresholds its null twin
+  // gives): an electrostatic spring, a Duffing term and a pickoff phase
+  // mismatch, which turns the excitation segments' measured phase with the
+  // pattern angle
+  const Concealed triple[] = {{Effect::electrostatic_spring, -3.278e-08},
+                              {Effect::duffing_stiffness, -0.0006684},
+                              {Effect::pickoff_phase_mismatch, -0.007778}};
+  bench::Scenario s = bench::test::telemetry_design(2026, 1, 360.0);
+  for (const auto& c : triple)
+    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
+  // WHEN it is audited
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "triple");
+  // THEN all three are findings within 20 % and within 2 of their sigmas
+  // (before: the segments' weights were measured against the baseline, which
+  // counted the phase mismatch's pull on their measured phase as noise, and
+  // the Duffing term was no finding)
+  STRCMP_EQUAL_TEXT("explained", r.verdict.c_str(), text.c_str());
+  CHECK_EQUAL_TEXT(3, static_cast<int>(r.findings.size()), text.c_str());
+  for (const auto& c : triple) {
+    check_finding(r, c, text);
+    const auto it = std::find_if(r.findings.begin(), r.findings.end(),
+                                 [&](const auto& f) { return f.effect == c.effect; });
+    CHECK_TEXT(std::abs(it->value - c.value) <= 2.0 * it->sigma, text.c_str());
+  }
+}
