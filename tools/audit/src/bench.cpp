@@ -224,10 +224,9 @@ void run_extra_cases(const BenchOptions& o, const Scenario& base, const AuditRes
                      uint64_t seed, const AuditFn& audit, std::string* log, BenchResult& res) {
   std::mt19937_64 g(seed ^ 0x5bd1e9955bd1e995ULL);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double corner_draw = u(g);  // drawn in every mode: the pair and triple stay the same
-  if (!o.multi_only) {
+  {
     Scenario s = base;
-    s.flicker_corner_hz = std::exp(std::log(0.3) + corner_draw * std::log(10.0));
+    s.flicker_corner_hz = std::exp(std::log(0.3) + u(g) * std::log(10.0));
     const auto [r, secs] = audit(bench::simulate(s));
     BenchCase c;
     c.kind = CaseKind::null_coloured;
@@ -267,7 +266,6 @@ void run_extra_cases(const BenchOptions& o, const Scenario& base, const AuditRes
     c.design = d, c.campaign = base.design, c.pll_reference = base.pll_reference;
     res.cases.push_back(c);
   }
-  if (o.multi_only) return;
   BenchCase c = outside_case(base, null_r, g, audit);
   ++res.outside;
   if (c.described) ++res.outside_described;
@@ -392,7 +390,7 @@ DesignPart run_design(const BenchOptions& o, int d) {
   const AuditResult null_r = run_null(base, d, timed_audit, part, o.verbose);
   std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
   for (const auto& cand : null_r.candidates) {
-    if (o.multi_only) break;
+    if (o.no_singles) break;
     if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
     run_single(base, cand, d, g, timed_audit, part, o.verbose);
   }

@@ -23,7 +23,7 @@ namespace {
 void bench_usage(std::FILE* f) {
   std::fprintf(f,
                "usage: hrg audit-bench [--n DESIGNS] [--design K] [--seed S] [--jobs N]\n"
-               "                       [--speed-hours H] [--verbose] [--multi-only]\n"
+               "                       [--speed-hours H] [--verbose] [--no-singles]\n"
                "                       [--save-multi DIR]\n\n"
                "Simulates DESIGNS random resonators and campaigns in turn: a ring-down campaign\n"
                "and envelope-controlled telemetry (sim_target's averaged model), and the\n"
@@ -35,8 +35,9 @@ void bench_usage(std::FILE* f) {
                "time (default 0: all cores); the results and the output do not depend on N.\n"
                "--design K runs design K of the seed's sequence alone (0-based; --n, when given,\n"
                "must be above K), with the recordings, lines and counts it has in the full run.\n"
-               "--multi-only runs only each design's null twin, pair and triple (the same\n"
-               "recordings as in the full run); --save-multi DIR writes every pair and triple\n"
+               "--no-singles skips the one-effect recordings (the others are those of the full\n"
+               "run: null twin, 1/f null, pair, triple, outside); --save-multi DIR writes every "
+               "pair and triple\n"
                "recording to DIR (designK_pair.csv.gz, designK_triple.csv.gz) for hrg audit.\n\n"
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
@@ -135,8 +136,8 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
     b.temp_follows_time = true;
   } else if (a == "--verbose") {
     b.o.verbose = true;
-  } else if (a == "--multi-only") {
-    b.o.multi_only = true;
+  } else if (a == "--no-singles") {
+    b.o.no_singles = true;
   } else if (a == "--save-multi" && has_value) {
     b.o.save_multi_dir = args[++i];
   } else {
