@@ -239,17 +239,11 @@ class Auditor {
   Mask baseline_mask() const;
   State fit_baseline(AuditResult& out);
   State adopt_block_noise(const Mask& base, State cur, AuditResult& out);
-  State weigh_excitation(const Mask& base, const State& against, const Params& start,
-                         AuditResult& out);
-  bool reselect_against_model(State& baseline, State& cur, std::vector<Chosen>& chosen,
-                              AuditResult& out);
-  State significant_part(const State& cur, const std::vector<Chosen>& chosen);
   void remove_feedthrough_pull(const State& cur, AuditResult& out);
   void remove_pump_phase_pull(const State& cur, AuditResult& out);
   void remove_angle_pull(AuditResult& out);
   void remove_frequency_pull(const State& cur, const FeedStat& ft, AuditResult& out);
-  State weight_forced_segments(const Mask& base, const State& cur, const Params& start,
-                               AuditResult& out);
+  State weight_forced_segments(const Mask& base, State cur, AuditResult& out);
   double forced_scatter(const std::vector<double>& fr, int p) const;
   void weight_balance(AuditResult& out);
   double balance_scatter(const std::vector<std::size_t>& use, double& se2) const;
@@ -290,10 +284,6 @@ class Auditor {
   // of c_x, c_y), when they show one (remove_feedthrough_pull).
   bool ft_shown_ = false;
   std::array<double, 4> ft_c_{};
-  // The excitation segments before any correction or weight, and the result
-  // as it stood then (reselect_against_model starts from both again).
-  std::vector<ForcedSegment> forced_raw_;
-  AuditResult out_raw_;
 };
 
 bool Auditor::testable(Effect e) const {
@@ -466,9 +456,8 @@ State Auditor::fit_baseline(AuditResult& out) {
   cur = fit_state(base, cur.fit.p, false);
   cur = adopt_block_noise(base, cur, out);
   if (d_.forced.size() >= 3) {
-    forced_raw_ = d_.forced;
-    out_raw_ = out;
-    cur = weigh_excitation(base, cur, cur.fit.p, out);
+    remove_feedthrough_pull(cur, out);
+    cur = weight_forced_segments(base, cur, out);
   }
   if (std::getenv("HRG_AUDIT_DEBUG")) {
     const auto fr = forced_residuals(d_, cur.fit.p);
@@ -482,70 +471,6 @@ State Auditor::fit_baseline(AuditResult& out) {
                  cur.kappa);
   }
   return cur;
-}
-
-// The excitation segments' corrections (a drive feedthrough's pulls, when
-// the switch-offs show one) and weights, measured against the model
-// `against`; returns the baseline refitted with them from `start`.
-State Auditor::weigh_excitation(const Mask& base, const State& against, const Params& start,
-                                AuditResult& out) {
-  remove_feedthrough_pull(against, out);
-  return weight_forced_segments(base, against, start, out);
-}
-
-// The excitation segments' corrections and weights are measured against the
-// baseline, which leaves out whatever the selection then finds. An effect
-// that moves the segments' measured phase by a shape their scatter does not
-// fit (a pickoff phase mismatch or misalignment turns it with the pattern
-// angle) is counted there as noise: it lowers every segment's weight, hides
-// a spring or Duffing term beside it, and fails the feedthrough's pull test
-// ("the pull leaves the segments at their noise") that the pull alone would
-// pass. So, once the selection has found something, the corrections and
-// weights are measured again against the selected model, and the selection
-// runs again from the baseline refitted with them. Returns whether it did.
-bool Auditor::reselect_against_model(State& baseline, State& cur, std::vector<Chosen>& chosen,
-                                     AuditResult& out) {
-  if (!eo_.use_forced || forced_raw_.empty() || chosen.empty()) return false;
-  const State against = significant_part(cur, chosen);
-  if (against.mask == baseline.mask) return false;
-  d_.forced = forced_raw_;
-  ft_shown_ = false;
-  ft_c_ = {};
-  out = out_raw_;
-  describe_data(out);
-  baseline = weigh_excitation(baseline.mask, against, baseline.fit.p, out);
-  cur = baseline;
-  chosen.clear();
-  forward_select(cur, chosen, out);
-  return true;
-}
-
-// The selected model `cur` with only the effects that stand min_significance
-// of their standard deviations from zero given the others, as the acceptance
-// rule counts it (weigh_findings); the others are left out and it is
-// refitted. Measured against a candidate that the rule then refuses, the
-// weights take its shape out of the noise and make it its own evidence: on a
-// firmware null with 1/f noise (design 11 of `--seed 2026`, corner 0.79 Hz) a
-// misalignment at 4.7 sigma became a finding at 5.6.
-State Auditor::significant_part(const State& cur, const std::vector<Chosen>& chosen) {
-  Mask mask = cur.mask;
-  Params p = cur.fit.p;
-  for (const auto& c : chosen) {
-    if (param_of(c.effect) < 0) continue;
-    const State without = fit_state(with_effect(cur.mask, c.effect, false),
-                                    without_effect(cur.fit.p, c.effect), false);
-    const double value = effect_value(c.effect, cur.fit.p);
-    double sigma = effect_sigma(c.effect, cur.fit.sigma);
-    if (!opt_.ar_whitening)
-      sigma /= std::sqrt(cur.kappa);
-    else
-      sigma =
-          std::max(sigma, std::abs(value) / std::sqrt(std::max(delta_chi2(without, cur), 1e-12)));
-    if (std::abs(value) >= opt_.min_significance * sigma) continue;
-    mask = with_effect(mask, c.effect, false);
-    p = without_effect(p, c.effect);
-  }
-  return mask == cur.mask ? cur : fit_state(mask, p, false);
 }
 
 // A drive feedthrough enters the measured signals, so the measured wave
@@ -723,8 +648,7 @@ State Auditor::adopt_block_noise(const Mask& base, State cur, AuditResult& out) 
 // what the frequency-shifting candidates could explain (pump voltage squared,
 // amplitude squared, temperature), so that the signature of an effect is not
 // counted as noise; with few segments only the pump term is taken out.
-State Auditor::weight_forced_segments(const Mask& base, const State& cur, const Params& start,
-                                      AuditResult& out) {
+State Auditor::weight_forced_segments(const Mask& base, State cur, AuditResult& out) {
   start_balance_ = cur.fit.p;
   const auto fr = forced_residuals(d_, cur.fit.p);
   const std::size_t n = fr.size();
@@ -740,7 +664,7 @@ State Auditor::weight_forced_segments(const Mask& base, const State& cur, const 
     f.sigma_rad_s = std::sqrt(f.se_rad_s * f.se_rad_s + extra2);
   weight_balance(out);
   eo_.use_forced = true;
-  return fit_state(base, start, false);
+  return fit_state(base, cur.fit.p, false);
 }
 
 // Sum of squares the excitation segments' frequency residuals `fr` leave
@@ -1521,12 +1445,11 @@ AuditResult Auditor::run(PlotData* plot) {
   out.notes = d_.notes;
   for (const auto& s : d_.free)
     n_blocks_fit_ += s.n_blocks;
-  State baseline = fit_baseline(out);
+  const State baseline = fit_baseline(out);
   describe_data(out);
   State cur = baseline;
   std::vector<Chosen> chosen;
   forward_select(cur, chosen, out);
-  reselect_against_model(baseline, cur, chosen, out);
   // The switching edges against the final free-decay model.
   const FeedStat ft = feedthrough_stat(d_, cur.fit.p, ln_neff(cur));
   test_feedthrough(cur, ft, chosen, out);
