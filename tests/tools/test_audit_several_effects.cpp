@@ -5,7 +5,10 @@
 // its noise in every recording (the null's included), a pull no catalogue
 // term holds; an effect acting on the free decays and the segments'
 // frequency is weighed where its evidence lies, not against that drift
-// (tools/audit/README.md step 7). Slow: one audit of 360 s of telemetry.
+// (tools/audit/README.md step 7). And a pickoff phase mismatch of degrees
+// beside a Duffing term on the firmware's telemetry, whose pump follows the
+// measured phase (step 2). Slow: an audit of 360 s of telemetry and one of
+// the firmware's.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
