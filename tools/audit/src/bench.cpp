@@ -14,6 +14,7 @@
 
 #include "batch/batch.hpp"
 #include "campaign.hpp"
+#include "recording/recording.hpp"
 
 namespace hrg::audit {
 
@@ -129,7 +130,7 @@ bool physical(const Scenario& base, Effect e, double value) {
 // Two or three distinct catalogue effects at once, each at 2x-3x its
 // threshold; a hit when every one is a finding with its parameter within 20 %.
 BenchCase multi_case(const Scenario& base, const AuditResult& null_r, int count, std::mt19937_64& g,
-                     const AuditFn& audit) {
+                     const AuditFn& audit, const std::string& save_path) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<const CandidateScore*> pool;
   for (const auto& cand : null_r.candidates) {
@@ -151,7 +152,9 @@ BenchCase multi_case(const Scenario& base, const AuditResult& null_r, int count,
     c.true_values.push_back(v);
     conceal(s, cand.effect, v, g);
   }
-  const auto [r, secs] = audit(bench::simulate(s));
+  const recording::Recording rec = bench::simulate(s);
+  if (!save_path.empty()) recording::write_recording(save_path, rec);
+  const auto [r, secs] = audit(rec);
   c.verdict = r.verdict;
   c.seconds = secs;
   c.findings = static_cast<int>(r.findings.size());
@@ -217,8 +220,8 @@ BenchCase outside_case(const Scenario& base, const AuditResult& null_r, std::mt1
 
 // The cases beyond one catalogue effect of a design: a null with coloured
 // noise, a pair, a triple and one effect outside the catalogue.
-void run_extra_cases(const Scenario& base, const AuditResult& null_r, int d, uint64_t seed,
-                     const AuditFn& audit, std::string* log, BenchResult& res) {
+void run_extra_cases(const BenchOptions& o, const Scenario& base, const AuditResult& null_r, int d,
+                     uint64_t seed, const AuditFn& audit, std::string* log, BenchResult& res) {
   std::mt19937_64 g(seed ^ 0x5bd1e9955bd1e995ULL);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   {
@@ -242,7 +245,11 @@ void run_extra_cases(const Scenario& base, const AuditResult& null_r, int d, uin
     res.cases.push_back(c);
   }
   for (int count : {2, 3}) {
-    BenchCase c = multi_case(base, null_r, count, g, audit);
+    const std::string save = o.save_multi_dir.empty()
+                                 ? std::string()
+                                 : o.save_multi_dir + "/design" + std::to_string(d) +
+                                       (count == 2 ? "_pair" : "_triple") + ".csv.gz";
+    BenchCase c = multi_case(base, null_r, count, g, audit, save);
     if (c.truths.empty()) continue;
     auto& n = count == 2 ? res.pairs : res.triples;
     auto& f = count == 2 ? res.pairs_found : res.triples_found;
@@ -383,11 +390,13 @@ DesignPart run_design(const BenchOptions& o, int d) {
   const AuditResult null_r = run_null(base, d, timed_audit, part, o.verbose);
   std::mt19937_64 g(seed ^ 0x9e3779b97f4a7c15ULL);
   for (const auto& cand : null_r.candidates) {
+    if (o.no_singles) break;
     if (!cand.testable || !(cand.threshold > 0.0) || !std::isfinite(cand.threshold)) continue;
     run_single(base, cand, d, g, timed_audit, part, o.verbose);
   }
   if (o.extra_cases)
-    run_extra_cases(base, null_r, d, seed, timed_audit, o.verbose ? &part.log : nullptr, part.res);
+    run_extra_cases(o, base, null_r, d, seed, timed_audit, o.verbose ? &part.log : nullptr,
+                    part.res);
   return part;
 }
 

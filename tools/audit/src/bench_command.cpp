@@ -23,7 +23,8 @@ namespace {
 void bench_usage(std::FILE* f) {
   std::fprintf(f,
                "usage: hrg audit-bench [--n DESIGNS] [--design K] [--seed S] [--jobs N]\n"
-               "                       [--speed-hours H] [--verbose]\n\n"
+               "                       [--speed-hours H] [--verbose] [--no-singles]\n"
+               "                       [--save-multi DIR]\n\n"
                "Simulates DESIGNS random resonators and campaigns in turn: a ring-down campaign\n"
                "and envelope-controlled telemetry (sim_target's averaged model), and the\n"
                "firmware's own telemetry (firmware + full-rate sim_target, as hrg sim runs it).\n"
@@ -33,7 +34,11 @@ void bench_usage(std::FILE* f) {
                "the audit of an H-hour 200 Hz recording (0: skip). --jobs N runs N designs at a\n"
                "time (default 0: all cores); the results and the output do not depend on N.\n"
                "--design K runs design K of the seed's sequence alone (0-based; --n, when given,\n"
-               "must be above K), with the recordings, lines and counts it has in the full run.\n\n"
+               "must be above K), with the recordings, lines and counts it has in the full run.\n"
+               "--no-singles skips the one-effect recordings (the others are those of the full\n"
+               "run: null twin, 1/f null, pair, triple, outside); --save-multi DIR writes every "
+               "pair and triple\n"
+               "recording to DIR (designK_pair.csv.gz, designK_triple.csv.gz) for hrg audit.\n\n"
                "       hrg audit-bench --emit OUT.csv[.gz] [--design ringdown|telemetry|firmware]\n"
                "                       [--duration S] [--seed S] [--effect ID VALUE] [--noise V]\n"
                "                       [--flicker CORNER_HZ] [--outside SHAPE VALUE] [--pll]\n"
@@ -131,6 +136,10 @@ bool parse_option(std::span<char* const> args, std::size_t& i, BenchArgs& b) {
     b.temp_follows_time = true;
   } else if (a == "--verbose") {
     b.o.verbose = true;
+  } else if (a == "--no-singles") {
+    b.o.no_singles = true;
+  } else if (a == "--save-multi" && has_value) {
+    b.o.save_multi_dir = args[++i];
   } else {
     std::fprintf(stderr, "hrg audit-bench: unexpected argument '%s'\n", args[i]);
     bench_usage(stderr);
@@ -213,6 +222,7 @@ int audit_bench_main(std::span<char* const> args) {
     std::fprintf(stderr, "hrg audit-bench: --n must not be negative\n");
     return 2;
   }
+  if (!b.o.save_multi_dir.empty()) std::filesystem::create_directories(b.o.save_multi_dir);
   if (b.o.designs > 0) {
     const BenchResult r = run_benchmark(b.o);
     if (b.o.only_design >= 0) {

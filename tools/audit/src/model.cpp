@@ -152,6 +152,27 @@ double measured_phase(const Params& p, double theta) {
   return dsp::wave_variables<double>({x.real(), -x.imag(), y.real(), -y.imag()}).phase_rad;
 }
 
+// The pump follows the measured phase of the vibration (the firmware's PLL
+// locks on it and the pump runs at a fixed phase from it), which the pickoff
+// map turns off the true one by delta(theta) = measured_phase(p, theta) (a
+// phase mismatch phi: about -phi sin^2 2theta; a gain or a misalignment
+// leaves a standing vibration's phase alone). Its parametric drive is then 2
+// delta off its best phase and pulls the true frequency by (a_A'/a_A + nu)
+// sin 2 delta (physics.md section 4; the same pull as a drive feedthrough's,
+// pump_phase_pull), weighted by the pump's drive V^2 over the segment. To
+// first order delta is a mean and a 4-theta harmonic: both from three
+// angles. Held (a_A'/a_A ~ 0) a phase mismatch of 1.5 deg pulls by ~0.026 nu
+// (1 - cos 4 theta); a ring-up by tens of that.
+double pickoff_pump_pull(const ForcedSegment& f, const Params& p) {
+  if (!(f.mean_v2 > 0.0) || p[kPhase] == 0.0) return 0.0;
+  const double d0 = std::remainder(measured_phase(p, 0.0), kPi);
+  const double d8 = std::remainder(measured_phase(p, kPi / 8.0), kPi);
+  const double d4 = std::remainder(measured_phase(p, kPi / 4.0), kPi);
+  const double mean = 0.5 * (d0 + d4), c4 = 0.5 * (d0 - d4), s4 = d8 - mean;
+  const double delta_v2 = mean * f.mean_v2 + c4 * f.mean_v2c4 + s4 * f.mean_v2s4;
+  return 2.0 * (f.dlna_per_s + p[kNu]) * delta_v2 / f.mean_v2;
+}
+
 }  // namespace
 
 double param_scale(int p) {
@@ -201,7 +222,7 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
     }
     double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);
     dm = std::remainder(dm, kPi);
-    w += dm / (f.t1_s - f.t0_s);
+    w += dm / (f.t1_s - f.t0_s) + pickoff_pump_pull(f, p);
     r.push_back(f.freq_rad_s - w);
   }
   return r;

@@ -36,6 +36,13 @@ struct BenchOptions {
   // Per design also a null with 1/f noise, a pair, a triple and one effect
   // outside the catalogue.
   bool extra_cases = true;
+  // Each design's null twin (it sets the thresholds) and its cases beyond
+  // one effect only: the same recordings as in the full run, the one-effect
+  // recordings skipped.
+  bool no_singles = false;
+  // Where each pair and triple recording is written for auditing by hand
+  // (DIR/design<K>_pair.csv.gz, DIR/design<K>_triple.csv.gz; empty: nowhere).
+  std::string save_multi_dir;
 };
 
 // What a benchmark recording holds: nothing (white or coloured noise), one
