@@ -209,9 +209,9 @@ def thermal_damping_sigmas(text):
 
 # The 20x-below-raw goal needs after <= raw / 20, and after the audit round a
 # row is at best a draw of the clean gyro's figure at the same length: where raw / 20
-# lies below the clean gyro's compensated ADB there, a calibration as good as
-# the truth misses it as often as not, and the run cannot tell a good one
-# from a bad one. The clean gyro's ADB
+# lies below the clean gyro's compensated ADB there, even the clean gyro's
+# own figure misses it, and the run cannot tell a good calibration from a
+# bad one. The clean gyro's ADB
 # is the noise floor of a 4 theta fit over the parks; from LONG_RUN_S the 5 s
 # windows bring it down ~10x (0.67 -> 0.054 deg/h on the 4.2 kHz resonator,
 # seed 1; ~T^-3/2). A 1 deg pickoff phase there lowers the raw drift to 6.55
