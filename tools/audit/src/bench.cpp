@@ -227,7 +227,11 @@ void run_extra_cases(const BenchOptions& o, const Scenario& base, const AuditRes
   {
     Scenario s = base;
     s.flicker_corner_hz = std::exp(std::log(0.3) + u(g) * std::log(10.0));
-    const auto [r, secs] = audit(bench::simulate(s));
+    const recording::Recording rec = bench::simulate(s);
+    if (!o.save_multi_dir.empty())
+      recording::write_recording(
+          o.save_multi_dir + "/design" + std::to_string(d) + "_coloured.csv.gz", rec);
+    const auto [r, secs] = audit(rec);
     BenchCase c;
     c.kind = CaseKind::null_coloured;
     c.top = top_of(r, c.top_value);

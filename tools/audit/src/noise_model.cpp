@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -40,6 +41,44 @@ LagSums lag_sums(const Dataset& d, const std::vector<double>& res, std::size_t c
 
 void fit_scale_var(const Dataset& d, const std::vector<double>& res, ArNoise& ar);
 
+// The excitation segments' observation groups in `res` after the free-decay
+// residuals (frequency, balance, angle drift; model.hpp's evaluate()), each
+// as [first, end) in time order; empty when `res` holds none or another
+// layout.
+std::vector<std::pair<std::size_t, std::size_t>> forced_groups(const Dataset& d, std::size_t n_free,
+                                                               std::size_t n_res) {
+  std::size_t n_bal = 0, n_ang = 0;
+  for (const auto& f : d.forced) {
+    n_bal += f.balance_sigma_per_s > 0.0 ? 1 : 0;
+    n_ang += f.angle_sigma_rad_s > 0.0 ? 1 : 0;
+  }
+  if (n_res != n_free + d.forced.size() + n_bal + n_ang || d.forced.empty()) return {};
+  const std::size_t b0 = n_free + d.forced.size(), a0 = b0 + n_bal;
+  return {{n_free, b0}, {b0, a0}, {a0, n_res}};
+}
+
+// Least-squares lag-1 coefficient of the excitation groups' residuals,
+// pooled, taken when BIC prefers it over none and it is positive: slow
+// noise raises the level of slow shapes, and a negative estimate (chance on
+// a few dozen segments) would lower their noise below the white level.
+double fit_forced_rho(const Dataset& d, const std::vector<double>& res, std::size_t n_free) {
+  double s00 = 0.0, s01 = 0.0, s11 = 0.0, n = 0.0;
+  for (const auto& [first, end] : forced_groups(d, n_free, res.size())) {
+    for (std::size_t i = first + 1; i < end; ++i) {
+      s00 += res[i] * res[i], s01 += res[i] * res[i - 1], s11 += res[i - 1] * res[i - 1];
+      n += 1.0;
+    }
+  }
+  if (n < 10.0 || !(s11 > 0.0) || !(s00 > 0.0)) return 0.0;
+  const double rho = s01 / s11;
+  const double var1 = (s00 - rho * s01) / n, var0 = s00 / n;
+  const bool taken = var1 > 0.0 && n * std::log(var1 / var0) + std::log(n) < 0.0;
+  if (std::getenv("HRG_AUDIT_DEBUG"))
+    std::fprintf(stderr, "excitation lag-1 %.3f over %.0f pairs (%s)\n", rho, n,
+                 taken ? "taken" : "not taken");
+  return taken && rho > 0.0 ? std::min(rho, 0.95) : 0.0;
+}
+
 }  // namespace
 
 ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res) {
@@ -72,6 +111,7 @@ ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res) {
     ar.orders[c] = std::move(all);
   }
   fit_scale_var(d, res, ar);
+  ar.forced_rho = fit_forced_rho(d, res, n_free);
   return ar;
 }
 
@@ -189,8 +229,24 @@ double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArN
     }
     k0 += 4 * seg.n_blocks;
   }
-  for (std::size_t i = k0; i < res.size(); ++i)
-    chi2 += res[i] * res[i];
+  const auto groups = forced_groups(d, k0, res.size());
+  if (groups.empty() || ar.forced_rho == 0.0) {
+    for (std::size_t i = k0; i < res.size(); ++i)
+      chi2 += res[i] * res[i];
+    return chi2;
+  }
+  // AR(1) filter of unit gain from one segment to the next (the fastest
+  // shape, alternating): slow noise only adds to the weights' level, at slow
+  // shapes, by up to ((1 + rho) / (1 - rho))^2 for a constant; the first of
+  // each group at the filter's stationary variance.
+  const double rho = ar.forced_rho, g2 = (1.0 + rho) * (1.0 + rho);
+  for (const auto& [first, end] : groups) {
+    chi2 += res[first] * res[first] * (1.0 - rho) / (1.0 + rho);
+    for (std::size_t i = first + 1; i < end; ++i) {
+      const double v = res[i] - rho * res[i - 1];
+      chi2 += v * v / g2;
+    }
+  }
   return chi2;
 }
 

@@ -34,6 +34,14 @@ struct ArNoise {
   // over the white level 1; 1 where not significantly above it.
   static constexpr int kScales = 16;
   std::array<std::array<double, kScales + 1>, 2> scale_var{};
+  // Lag-1 coefficient of the excitation segments' observations from one
+  // segment to the next (frequency, amplitude balance and pattern-angle
+  // drift, each in time order, pooled): 0 unless BIC takes it and it is
+  // positive. They are read from the end rows of segments a free window
+  // apart, and slow noise on the demodulated signals (an offset beating
+  // with the vibration's phase turning in the demodulation frame) moves
+  // neighbours alike.
+  double forced_rho = 0.0;
   ArNoise() {
     for (auto& v : scale_var)
       v.fill(1.0);
@@ -50,7 +58,9 @@ ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res);
 
 // chi^2 of the free-decay residuals after whitening with `ar` (each channel's
 // prediction error over its innovation variance; the first rows of a segment
-// use the lags they have), plus the excitation-segment residuals unchanged.
+// use the lags they have), plus the excitation-segment residuals filtered by
+// forced_rho at unit gain for the fastest shape (slow noise only adds to
+// their weights' level, at slow shapes).
 double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArNoise& ar);
 
 }  // namespace hrg::audit::detail
