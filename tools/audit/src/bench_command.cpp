@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include "audit/audit.hpp"
 #include "audit/audit_command.hpp"
 #include "audit/bench.hpp"
@@ -70,8 +72,11 @@ bool parse_design(std::string_view name, bench::Design& d) {
 double speed_run(double hours, uint64_t seed) {
   const auto s = bench::random_scenario(bench::Design::telemetry, hours * 3600.0, seed);
   const auto rec = bench::simulate(s);
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("hrg_audit_speed_" + std::to_string(seed) + ".csv.gz");
+  // The process id in the name: two benchmarks with the same seed at once
+  // must not write and remove each other's file.
+  const auto path =
+      std::filesystem::temp_directory_path() /
+      ("hrg_audit_speed_" + std::to_string(seed) + "_" + std::to_string(::getpid()) + ".csv.gz");
   recording::write_recording(path, rec);
   const auto t0 = std::chrono::steady_clock::now();
   const auto back = recording::read_recording(path);
