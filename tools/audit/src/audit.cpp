@@ -51,7 +51,8 @@ constexpr std::size_t kBalanceMinSegments = 10;
 // (0.15-0.25 nu on the default run) the firmware's pump phase is still
 // settling and its efficiency c is 7 % lower than held (PumpGain's c1 takes
 // that up, less well: on the default run's gap row the file then gives 1.26
-// deg/h against 0.94 from the held segments alone); beyond kBalanceHold the
+// deg/h against 0.94 from the held segments alone); the held among them then
+// have a gain of their own (PumpGain::c_settled); beyond kBalanceHold the
 // wave rings up with the pump saturated, never used.
 constexpr double kBalanceHeld = 0.05;
 constexpr double kBalanceHold = 0.5;
@@ -706,14 +707,22 @@ void Auditor::weight_balance(AuditResult& out) {
     return use;
   };
   std::vector<std::size_t> use = segments_within(kBalanceHeld);
-  if (use.size() < kBalanceMinSegments) use = segments_within(kBalanceHold);
+  if (use.size() < kBalanceMinSegments) {
+    // The few held among the recovering: their pump has settled (PumpGain).
+    for (std::size_t i : use)
+      d_.forced[i].pump_settled = true;
+    use = segments_within(kBalanceHold);
+  }
   const std::size_t n = use.size();
   if (n < kBalanceMinSegments) return;
   if (ft_shown_) remove_balance_pull(use, out);
   double se2 = 0.0;
   const double rss = balance_scatter(use, se2);
   const double floor = kBalanceFloor * nu * 1.0;
-  const double e2 = std::max(floor * floor, rss / static_cast<double>(n - 4) - se2);
+  const bool any_settled =
+      std::any_of(use.begin(), use.end(), [&](std::size_t i) { return d_.forced[i].pump_settled; });
+  const double dof = static_cast<double>(n - (any_settled ? 5 : 4));
+  const double e2 = std::max(floor * floor, rss / dof - se2);
   if (std::getenv("HRG_AUDIT_DEBUG")) {
     const std::vector<double> left = balance_left(d_, start_balance_);
     std::fprintf(stderr, "balance: %zu segments, e %.3g (floor %.3g), se2 %.3g\n", n, std::sqrt(e2),
@@ -738,15 +747,17 @@ void Auditor::weight_balance(AuditResult& out) {
 double Auditor::balance_scatter(const std::vector<std::size_t>& use, double& se2) const {
   const std::size_t n = use.size();
   const std::vector<double> left = balance_left(d_, start_balance_);
-  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 4);
+  Eigen::MatrixXd h(static_cast<Eigen::Index>(n), 5);
   Eigen::VectorXd y(static_cast<Eigen::Index>(n));
   se2 = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& f = d_.forced[use[k]];
     const auto r = static_cast<Eigen::Index>(k);
     const double t = f.t1_s - f.t0_s;
-    h(r, 0) = t * f.mean_v2, h(r, 1) = t * f.mean_v2c4, h(r, 2) = t * f.mean_v2s4;
-    h(r, 3) = t * f.dlna_per_s * f.mean_v2;
+    const double settled = f.pump_settled ? 1.0 : 0.0;
+    h(r, 0) = t * f.mean_v2 * (1.0 - settled), h(r, 4) = t * f.mean_v2 * settled;
+    h(r, 1) = t * f.mean_v2c4, h(r, 2) = t * f.mean_v2s4;
+    h(r, 3) = t * true_growth_per_s(f, start_balance_) * f.mean_v2 * (1.0 - settled);
     y(r) = t * left[use[k]];
     se2 += t * t * f.balance_se_per_s * f.balance_se_per_s / static_cast<double>(n);
   }
