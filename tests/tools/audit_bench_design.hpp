@@ -17,6 +17,13 @@ inline Scenario pll_telemetry_design(uint64_t bench_seed, uint64_t design, doubl
   return s;
 }
 
+// A telemetry design whose reference is fixed ((d / 3) even).
+inline Scenario telemetry_design(uint64_t bench_seed, uint64_t design, double duration_s) {
+  Scenario s = random_scenario(Design::telemetry, duration_s, bench_seed * 100003ULL + design);
+  s.temp_cycles = true;
+  return s;
+}
+
 // A firmware design (d % 3 == 2) as the bench builds it: the firmware's own
 // telemetry, its reference fixed, a temperature that does not follow time.
 inline Scenario firmware_design(uint64_t bench_seed, uint64_t design) {

@@ -49,6 +49,10 @@ struct ForcedSegment {
   double dlna_per_s = 0.0;  // (ln a_A(end) - ln a_A(start)) / (t1 - t0), ends as for the phase
   double balance_se_per_s = 0.0;     // of dlna_per_s, from the white noise
   double balance_sigma_per_s = 0.0;  // weight of the amplitude balance (0: not used)
+  // Held by the amplitude loop among segments that recover from a window:
+  // the pump's efficiency once its phase has settled is a constant of its
+  // own (PumpGain), not the recovering segments' law at a_A'/a_A = 0.
+  bool pump_settled = false;
   // The pattern-angle drift (theta1 - theta0) / angle_span_s: its end angles
   // are single rows, so it is read over those rows' own span (the three-row
   // means' t1 - t0 is two rows shorter and left 2 dt / T of K Omega / 2 in it).

@@ -5,6 +5,8 @@
 #include <initializer_list>
 #include <numbers>
 
+#include <Eigen/Dense>
+
 #include "dsp/wave_variables.hpp"
 
 namespace hrg::audit::detail {
@@ -170,7 +172,7 @@ double pickoff_pump_pull(const ForcedSegment& f, const Params& p) {
   const double d4 = std::remainder(measured_phase(p, kPi / 4.0), kPi);
   const double mean = 0.5 * (d0 + d4), c4 = 0.5 * (d0 - d4), s4 = d8 - mean;
   const double delta_v2 = mean * f.mean_v2 + c4 * f.mean_v2c4 + s4 * f.mean_v2s4;
-  return 2.0 * (f.dlna_per_s + p[kNu]) * delta_v2 / f.mean_v2;
+  return 2.0 * (true_growth_per_s(f, p) + p[kNu]) * delta_v2 / f.mean_v2;
 }
 
 }  // namespace
@@ -248,16 +250,20 @@ double measured_theta(const Params& p, double theta) {
 }
 }  // namespace
 
+double true_growth_per_s(const ForcedSegment& f, const Params& p) {
+  if (!any_of(p, {kGain, kMis})) return f.dlna_per_s;
+  const double readout =
+      std::log(measured_wave(p, f.theta1_rad).a_A_v / measured_wave(p, f.theta0_rad).a_A_v);
+  return f.dlna_per_s - readout / (f.t1_s - f.t0_s);
+}
+
 std::vector<double> balance_left(const Dataset& d, const Params& p) {
   std::vector<double> left;
   left.reserve(d.forced.size());
   for (const auto& f : d.forced) {
     const double dT = f.mean_temp_c - d.temp_ref_c;
     const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
-    // The amplitude the pickoffs show changes with the angle by itself.
-    const double readout =
-        std::log(measured_wave(p, f.theta1_rad).a_A_v / measured_wave(p, f.theta0_rad).a_A_v);
-    left.push_back(f.dlna_per_s - readout / (f.t1_s - f.t0_s) +
+    left.push_back(true_growth_per_s(f, p) +
                    s * (p[kNu] + p[kDnuC] * f.mean_c4 + p[kDnuS] * f.mean_s4));
   }
   return left;
@@ -271,19 +277,32 @@ double pump_drive_v2(const ForcedSegment& f, const Params& p) {
 }  // namespace
 
 PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left) {
-  // Weighted least squares of left = (c0 + c1 dlna) M over the segments.
-  double n00 = 0.0, n01 = 0.0, n11 = 0.0, r0 = 0.0, r1 = 0.0;
+  // Weighted least squares of left = (c0 + c1 a_A'/a_A) M over the segments
+  // that recover, c_settled M over those that hold among them.
+  Eigen::Matrix3d n = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  bool any_settled = false;
   for (std::size_t i = 0; i < d.forced.size(); ++i) {
     const ForcedSegment& f = d.forced[i];
     if (!(f.balance_sigma_per_s > 0.0)) continue;
     const double w = 1.0 / (f.balance_sigma_per_s * f.balance_sigma_per_s);
-    const double m = pump_drive_v2(f, p), u = f.dlna_per_s * m;
-    n00 += w * m * m, n01 += w * m * u, n11 += w * u * u;
-    r0 += w * left[i] * m, r1 += w * left[i] * u;
+    const double m = pump_drive_v2(f, p);
+    const Eigen::Vector3d h = f.pump_settled ? Eigen::Vector3d(0.0, 0.0, m)
+                                             : Eigen::Vector3d(m, true_growth_per_s(f, p) * m, 0.0);
+    any_settled = any_settled || f.pump_settled;
+    n += w * h * h.transpose();
+    r += w * left[i] * h;
   }
-  const double det = n00 * n11 - n01 * n01;
-  if (!(det > 1e-12 * n00 * n11)) return {n00 > 0.0 ? r0 / n00 : 0.0, 0.0};
-  return {(n11 * r0 - n01 * r1) / det, (n00 * r1 - n01 * r0) / det};
+  PumpGain c;
+  const double det = n(0, 0) * n(1, 1) - n(0, 1) * n(0, 1);
+  if (det > 1e-12 * n(0, 0) * n(1, 1)) {
+    c.c0 = (n(1, 1) * r(0) - n(0, 1) * r(1)) / det;
+    c.c1 = (n(0, 0) * r(1) - n(0, 1) * r(0)) / det;
+  } else if (n(0, 0) > 0.0) {
+    c.c0 = r(0) / n(0, 0);
+  }
+  c.c_settled = any_settled ? r(2) / n(2, 2) : c.c0;
+  return c;
 }
 
 std::vector<double> balance_residuals(const Dataset& d, const Params& p) {
@@ -292,7 +311,8 @@ std::vector<double> balance_residuals(const Dataset& d, const Params& p) {
   const PumpGain c = balance_pump_gain(d, p, left);
   for (std::size_t i = 0; i < d.forced.size(); ++i) {
     const ForcedSegment& f = d.forced[i];
-    if (f.balance_sigma_per_s > 0.0) r.push_back(left[i] - c.at(f) * pump_drive_v2(f, p));
+    if (f.balance_sigma_per_s > 0.0)
+      r.push_back(left[i] - c.at(f, true_growth_per_s(f, p)) * pump_drive_v2(f, p));
   }
   return r;
 }
@@ -303,7 +323,7 @@ std::vector<double> angle_residuals(const Dataset& d, const Params& p) {
   const PumpGain gain = balance_pump_gain(d, p, left);
   for (const auto& f : d.forced) {
     if (!(f.angle_sigma_rad_s > 0.0)) continue;
-    const double c = gain.at(f);
+    const double c = gain.at(f, true_growth_per_s(f, p));
     const double dT = f.mean_temp_c - d.temp_ref_c;
     const double s = (1.0 + p[kNld] * f.mean_a2) * (1.0 + p[kTd] * dT);
     const double drift = s * (p[kDnuC] * f.mean_s4 - p[kDnuS] * f.mean_c4) +

@@ -105,11 +105,26 @@ std::vector<double> balance_residuals(const Dataset& d, const Params& p);
 // The left side of the balance per segment (1/s) and the pump gain of the
 // weighted fit (1/(s V^2)): c = c0 + c1 a_A'/a_A, the pump's efficiency
 // while the amplitude loop recovers from a window (its phase settling) is
-// not the one while it holds.
+// not the one while it holds. Where the recovering segments are used (fewer
+// than ten held), the few held among them (ForcedSegment::pump_settled) have
+// a gain of their own, c_settled: the firmware's telemetry holds one, the
+// still segment at the run's end, 5 % above the recovering segments' line at
+// a_A'/a_A = 0 (design 11 of `audit-bench --seed 2026`), and through the line
+// that offset read as a damping anisotropy at its angle, so as a pickoff
+// misalignment of about -0.006 deg (tools/audit/README.md, step 3).
 std::vector<double> balance_left(const Dataset& d, const Params& p);
+// The true vibration's growth a_A'/a_A over excitation segment f (1/s): its
+// measured growth less the change the pickoff map's readout makes between
+// the segment's end angles (a gain g shows a_A (1 + g sin^2 2theta), a
+// misalignment b a_A (1 + b sin 4theta)). The pump's efficiency and the
+// pump's pull follow the true vibration; at the measured growth the pump's
+// law read a gain's readout 2 g theta' sin 4theta as its efficiency.
+double true_growth_per_s(const ForcedSegment& f, const Params& p);
 struct PumpGain {
-  double c0 = 0.0, c1 = 0.0;
-  double at(const ForcedSegment& f) const { return c0 + c1 * f.dlna_per_s; }
+  double c0 = 0.0, c1 = 0.0, c_settled = 0.0;
+  double at(const ForcedSegment& f, double growth_per_s) const {
+    return f.pump_settled ? c_settled : c0 + c1 * growth_per_s;
+  }
 };
 PumpGain balance_pump_gain(const Dataset& d, const Params& p, const std::vector<double>& left);
 
