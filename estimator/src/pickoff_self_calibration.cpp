@@ -287,7 +287,9 @@ double readout_phase_sigmas(const PickoffSelfCalResult& r) {
 }
 
 double readout_phase_drift_share(const PickoffSelfCalResult& r, const ParamVector& p) {
-  const double removed = std::hypot(p(kDnuC), p(kDnuS));
+  // Every output frame (the firmware's model check): sqrt, not hypot (no
+  // overflow at these magnitudes, a fraction of the cost).
+  const double removed = std::sqrt(p(kDnuC) * p(kDnuC) + p(kDnuS) * p(kDnuS));
   if (r.status != Status::ok || !(removed > 0.0)) return 0.0;
   return 2.0 * std::fabs(p(kNu) * r.phase_rad) / removed;
 }
