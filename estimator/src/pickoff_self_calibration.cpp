@@ -40,6 +40,31 @@ double rho_of_gain(double g) {
   return (k - 1.0) / (k + 1.0);
 }
 
+// The pickoff gain and misalignment of a fit's level-pattern coefficients
+// (rho, bh) and their variances; `held` false outside the map the model
+// holds for.
+struct LevelPattern {
+  bool held = false;
+  double gain = 0.0;
+  double gain_sigma = 0.0;
+  double misalignment_rad = 0.0;
+  double misalignment_sigma_rad = 0.0;
+};
+
+LevelPattern level_pattern(double rho, double bh, double var_rho, double var_bh) {
+  LevelPattern l;
+  const double sin2b = 2.0 * bh * std::sqrt(std::max(0.0, 1.0 - rho * rho));
+  if (!(std::fabs(rho) < 0.5) || !(std::fabs(sin2b) < 0.5)) return l;
+  l.held = true;
+  // rho = (k - 1)/(k + 1) with k = (1 + g)^2: 1 + g = sqrt((1 + rho)/(1 - rho)).
+  l.gain = std::sqrt((1.0 + rho) / (1.0 - rho)) - 1.0;
+  l.gain_sigma = std::sqrt(var_rho) / ((1.0 - rho) * std::sqrt(1.0 - rho * rho));
+  l.misalignment_rad = 0.5 * std::asin(sin2b);
+  l.misalignment_sigma_rad =
+      std::sqrt(var_bh) * std::sqrt(1.0 - rho * rho) / std::cos(2.0 * l.misalignment_rad);
+  return l;
+}
+
 }  // namespace
 
 void PickoffSelfCalibration::reset() { *this = PickoffSelfCalibration{}; }
@@ -169,10 +194,9 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
   const AugmentedFit<kE - 1> d = fit_augmented<kE - 1, kE + 1>(ad_, 1);
   const double var = e.rss / dof;
   const double var_q = q.rss / dof_quad;
-  const double rho = e.p(kRho);
-  const double bh = e.p(kBh);
-  const double sin2b = 2.0 * bh * std::sqrt(std::max(0.0, 1.0 - rho * rho));
-  if (!(std::fabs(rho) < 0.5) || !(std::fabs(sin2b) < 0.5)) {
+  const LevelPattern l =
+      level_pattern(e.p(kRho), e.p(kBh), e.n_inv(kRho, kRho) * var, e.n_inv(kBh, kBh) * var);
+  if (!l.held) {
     r.status = Status::ill_conditioned;  // not a pickoff map the model holds for
     return r;
   }
@@ -182,12 +206,10 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
   r.dnu_s_per_s = e.p(2);
   r.dnu_c_sigma_per_s = std::sqrt(e.n_inv(1, 1) * var);
   r.dnu_s_sigma_per_s = std::sqrt(e.n_inv(2, 2) * var);
-  // rho = (k - 1)/(k + 1) with k = (1 + g)^2: 1 + g = sqrt((1 + rho)/(1 - rho)).
-  r.gain = std::sqrt((1.0 + rho) / (1.0 - rho)) - 1.0;
-  r.gain_sigma = std::sqrt(e.n_inv(kRho, kRho) * var) / ((1.0 - rho) * std::sqrt(1.0 - rho * rho));
-  r.misalignment_rad = 0.5 * std::asin(sin2b);
-  r.misalignment_sigma_rad = std::sqrt(e.n_inv(kBh, kBh) * var) * std::sqrt(1.0 - rho * rho) /
-                             std::cos(2.0 * r.misalignment_rad);
+  r.gain = l.gain;
+  r.gain_sigma = l.gain_sigma;
+  r.misalignment_rad = l.misalignment_rad;
+  r.misalignment_sigma_rad = l.misalignment_sigma_rad;
   r.level_8th_c = e.p(kHc);
   r.level_8th_s = e.p(kHs);
   r.dw_c_rad_s = q.p(0);
@@ -200,6 +222,21 @@ PickoffSelfCalResult PickoffSelfCalibration::solve(double max_kappa) const {
   r.decay_f = ((e.rss - d.rss) / extra) / (d.rss / dof_detrended);
   r.decay_f_limit = 1.0 + kSelfCalDecaySigmas * std::sqrt(2.0 / extra);
   r.decay_consistent = r.decay_f <= r.decay_f_limit;
+  // The decay test's fit: its columns are the level fit's without nu.
+  const double var_d = d.rss / dof_detrended;
+  const LevelPattern ld =
+      level_pattern(d.p(kRho - 1), d.p(kBh - 1), d.n_inv(kRho - 1, kRho - 1) * var_d,
+                    d.n_inv(kBh - 1, kBh - 1) * var_d);
+  if (ld.held) {
+    r.per_window_gain = ld.gain;
+    r.per_window_gain_sigma = ld.gain_sigma;
+    r.per_window_misalignment_rad = ld.misalignment_rad;
+    r.per_window_misalignment_sigma_rad = ld.misalignment_sigma_rad;
+  }
+  r.per_window_dnu_c_per_s = d.p(0);
+  r.per_window_dnu_s_per_s = d.p(1);
+  r.per_window_dnu_c_sigma_per_s = std::sqrt(d.n_inv(0, 0) * var_d);
+  r.per_window_dnu_s_sigma_per_s = std::sqrt(d.n_inv(1, 1) * var_d);
   return r;
 }
 
@@ -220,19 +257,41 @@ void PickoffSelfCalibration::refer_to_applied(const PickoffSelfCalResult& applie
 
 double damping_anisotropy_disagreement_sigmas(const PickoffSelfCalResult& r, const ParamVector& p,
                                               double sigma_dnu_c_per_s, double sigma_dnu_s_per_s) {
-  if (r.status != Status::ok || !r.decay_consistent) return 0.0;
+  if (r.status != Status::ok) return 0.0;
   const auto z = [](double a, double b, double sa, double sb) {
     const double s = std::hypot(sa, sb);
     return s > 0.0 ? std::fabs(a - b) / s : 0.0;
   };
-  return std::max(z(p(kDnuC), r.dnu_c_per_s, sigma_dnu_c_per_s, r.dnu_c_sigma_per_s),
-                  z(p(kDnuS), r.dnu_s_per_s, sigma_dnu_s_per_s, r.dnu_s_sigma_per_s));
+  // Where one decay rate does not hold, the fit with a rate per window.
+  const bool one = r.decay_consistent;
+  const double c = one ? r.dnu_c_per_s : r.per_window_dnu_c_per_s;
+  const double s = one ? r.dnu_s_per_s : r.per_window_dnu_s_per_s;
+  const double sc = one ? r.dnu_c_sigma_per_s : r.per_window_dnu_c_sigma_per_s;
+  const double ss = one ? r.dnu_s_sigma_per_s : r.per_window_dnu_s_sigma_per_s;
+  return std::max(z(p(kDnuC), c, sigma_dnu_c_per_s, sc), z(p(kDnuS), s, sigma_dnu_s_per_s, ss));
 }
 
 double readout_pattern_sigmas(const PickoffSelfCalResult& r) {
-  if (r.status != Status::ok || !r.decay_consistent) return 0.0;
+  if (r.status != Status::ok) return 0.0;
   const auto z = [](double x, double sigma) { return sigma > 0.0 ? std::fabs(x) / sigma : 0.0; };
+  if (!r.decay_consistent) {
+    return std::max(z(r.per_window_gain, r.per_window_gain_sigma),
+                    z(r.per_window_misalignment_rad, r.per_window_misalignment_sigma_rad));
+  }
   return std::max(z(r.gain, r.gain_sigma), z(r.misalignment_rad, r.misalignment_sigma_rad));
+}
+
+double readout_phase_sigmas(const PickoffSelfCalResult& r) {
+  if (r.status != Status::ok || !(r.phase_sigma_rad > 0.0)) return 0.0;
+  return std::fabs(r.phase_rad) / r.phase_sigma_rad;
+}
+
+double readout_phase_drift_share(const PickoffSelfCalResult& r, const ParamVector& p) {
+  // Every output frame (the firmware's model check): sqrt, not hypot (no
+  // overflow at these magnitudes, a fraction of the cost).
+  const double removed = std::sqrt(p(kDnuC) * p(kDnuC) + p(kDnuS) * p(kDnuS));
+  if (r.status != Status::ok || !(removed > 0.0)) return 0.0;
+  return 2.0 * std::fabs(p(kNu) * r.phase_rad) / removed;
 }
 
 }  // namespace hrg::est

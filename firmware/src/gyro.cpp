@@ -288,6 +288,11 @@ void Gyro::check_model() {
                                h.readout_pattern_sigmas > cfg_.max_readout_pattern_sigmas;
   control_drift_withheld_ =
       cfg_.compensate_control_drift && (readout_in_damping || readout_pattern);
+  // A phase lag left in the readout drifts the output by 2 nu phi, which
+  // the model does not have (EstimatorHealth::readout_phase_drift_share).
+  const bool phase_drift = cfg_.max_readout_phase_sigmas > 0.0 &&
+                           h.readout_phase_sigmas > cfg_.max_readout_phase_sigmas &&
+                           h.readout_phase_drift_share > cfg_.max_readout_phase_drift_share;
   uint8_t why = 0;
   const auto add = [&why](bool c, CompensationReason r) {
     if (c) why = static_cast<uint8_t>(why | reason_bit(r));
@@ -298,6 +303,7 @@ void Gyro::check_model() {
   add(control_lost, CompensationReason::control_drift_lost);
   add(readout_in_damping, CompensationReason::readout_in_damping);
   add(control_drift_withheld_, CompensationReason::control_drift_withheld);
+  add(phase_drift, CompensationReason::readout_phase_drift);
   status_.compensation_reasons = why;
   // A withheld D_Phi leaves the output short of a drift only while the
   // pump's part was in use; otherwise it withholds nothing measured.

@@ -130,12 +130,18 @@ TEST(PickoffSelfCalibration, AModelThatTookTheLevelPatternForDampingStandsOutOfI
   p(kDnuS) += 20.0 * ss;
   const double z_off = hrg::est::damping_anisotropy_disagreement_sigmas(r, p, sc, ss);
   DOUBLES_EQUAL(20.0 / std::sqrt(2.0), z_off, z_true + 1e-9);
-  // and nothing is said when the windows did not hold one decay rate or the
-  // solve was refused.
+  // and when the windows did not hold one decay rate, the fit with a decay
+  // rate per window speaks instead (here its dnu_S 20 of the model's sigma
+  // and its own from the model's),
   PickoffSelfCalResult inconsistent = r;
   inconsistent.decay_consistent = false;
-  DOUBLES_EQUAL(0.0, hrg::est::damping_anisotropy_disagreement_sigmas(inconsistent, p, sc, ss),
-                0.0);
+  inconsistent.per_window_dnu_c_per_s = p(kDnuC);
+  inconsistent.per_window_dnu_s_per_s = p(kDnuS) - 20.0 * ss;
+  inconsistent.per_window_dnu_c_sigma_per_s = ss;
+  inconsistent.per_window_dnu_s_sigma_per_s = ss;
+  DOUBLES_EQUAL(20.0 / std::sqrt(2.0),
+                hrg::est::damping_anisotropy_disagreement_sigmas(inconsistent, p, sc, ss), 1e-9);
+  // and nothing is said when the solve was refused.
   PickoffSelfCalResult refused = r;
   refused.status = Status::ill_conditioned;
   DOUBLES_EQUAL(0.0, hrg::est::damping_anisotropy_disagreement_sigmas(refused, p, sc, ss), 0.0);
@@ -155,10 +161,13 @@ TEST(PickoffSelfCalibration, TheReadoutPatternsSignificanceIsTheLargerOfGainAndM
   const PickoffSelfCalResult ideal = run_windows(Map{}, kMixedRates, 40);
   CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(ideal.status));
   CHECK_TRUE(hrg::est::readout_pattern_sigmas(ideal) < 4.0);
-  // AND nothing is said when one decay rate does not hold or the solve was refused
+  // AND where one decay rate does not hold, the fit with a rate per window speaks
   PickoffSelfCalResult inconsistent = r;
   inconsistent.decay_consistent = false;
-  DOUBLES_EQUAL(0.0, hrg::est::readout_pattern_sigmas(inconsistent), 0.0);
+  const double z_w = std::max(r.per_window_gain / r.per_window_gain_sigma,
+                              r.per_window_misalignment_rad / r.per_window_misalignment_sigma_rad);
+  DOUBLES_EQUAL(z_w, hrg::est::readout_pattern_sigmas(inconsistent), 1e-9 * z_w);
+  // AND nothing is said when the solve was refused
   PickoffSelfCalResult refused = r;
   refused.status = Status::ill_conditioned;
   DOUBLES_EQUAL(0.0, hrg::est::readout_pattern_sigmas(refused), 0.0);
@@ -257,6 +266,55 @@ TEST(PickoffSelfCalibration, ADampingThatChangesBetweenWindowsFailsTheDecayTest)
               r.decay_f, r.decay_f_limit, r.gain, r.gain_sigma);
   CHECK_FALSE(r.decay_consistent);
   CHECK_TRUE(r.decay_f > 2.0 * r.decay_f_limit);
+}
+
+TEST(PickoffSelfCalibration, WhereTheDecayTestRefusesTheWindowsOwnRatesStillReadTheGain) {
+  // GIVEN the damping 2 % different from window to window, which the decay
+  // test refuses the common-nu fit for
+  const PickoffSelfCalResult ideal =
+      run_windows(Map{}, kMixedRates, 40, kSelfCalMaxKappa, {}, 0.02);
+  const PickoffSelfCalResult gain =
+      run_windows(Map{0.02, 0.0}, kMixedRates, 40, kSelfCalMaxKappa, {}, 0.02);
+  CHECK_FALSE(ideal.decay_consistent);
+  CHECK_FALSE(gain.decay_consistent);
+  std::printf(
+      "\n  nu +-2 %% between windows, rate per window: g %.5f +- %.1e (truth 0.02), "
+      "ideal %.1e +- %.1e\n",
+      gain.per_window_gain, gain.per_window_gain_sigma, ideal.per_window_gain,
+      ideal.per_window_gain_sigma);
+  // THEN the fit with a decay rate per window reads a -0.02 ... 0.02 gain
+  // within its sigmas, thousands of them from zero: the readout check
+  // speaks (it said 0 here before),
+  CHECK_TRUE(std::fabs(gain.per_window_gain - 0.02) < 4.0 * gain.per_window_gain_sigma);
+  CHECK_TRUE(hrg::est::readout_pattern_sigmas(gain) > 100.0);
+  // AND the damping that changes between windows reads as no pattern there
+  CHECK_TRUE(hrg::est::readout_pattern_sigmas(ideal) < 4.0);
+}
+
+TEST(PickoffSelfCalibration, APhaseLagsDriftShareIsTwoNuPhiOverTheAnisotropy) {
+  // GIVEN a 1 deg phase lag identified from mixed rates
+  const PickoffSelfCalResult r = run_windows(Map{0.0, 0.0, 1.0 * kDeg}, kMixedRates, 40);
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r.status));
+  // THEN it stands |phi| / sigma_phi from zero, thousands of sigmas
+  const double z = hrg::est::readout_phase_sigmas(r);
+  DOUBLES_EQUAL(std::fabs(r.phase_rad) / r.phase_sigma_rad, z, 1e-9 * z);
+  CHECK_TRUE(z > 100.0);
+  // AND its drift 2 nu |phi| against the model's |dnu| (seed_params: nu
+  // dmu = 0.05 nu): 2 phi / 0.05 = 0.70 at 1 deg, above the 1/2 beyond
+  // which the compensated output may be worse than raw
+  const ParamVector p = hrg::est::test::seed_params(20.0 * kDeg, 5.0 * kDeg);
+  const double share = hrg::est::readout_phase_drift_share(r, p);
+  DOUBLES_EQUAL(2.0 * p(kNu) * std::fabs(r.phase_rad) / std::hypot(p(kDnuC), p(kDnuS)), share,
+                1e-12);
+  DOUBLES_EQUAL(40.0 * std::fabs(r.phase_rad), share, 1e-9);
+  CHECK_TRUE(share > 0.6);
+  // AND ideal pickoffs stand within the noise; a refused solve says nothing
+  const PickoffSelfCalResult ideal = run_windows(Map{}, kMixedRates, 40);
+  CHECK_TRUE(hrg::est::readout_phase_sigmas(ideal) < 4.0);
+  PickoffSelfCalResult refused = r;
+  refused.status = Status::ill_conditioned;
+  DOUBLES_EQUAL(0.0, hrg::est::readout_phase_sigmas(refused), 0.0);
+  DOUBLES_EQUAL(0.0, hrg::est::readout_phase_drift_share(refused, p), 0.0);
 }
 
 TEST(PickoffSelfCalibration, WithoutWindowsAtDifferentRatesTheSolveIsRefused) {

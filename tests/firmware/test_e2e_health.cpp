@@ -11,6 +11,12 @@
 // a gap harmonic of 0.18-0.36 at 8-11 of its sigmas: -9.04 deg/h of mean
 // D_Phi/K added before. A real gap (eps_p 0.02, eps_q 0.01) leaves no pattern
 // in the free decays' level: its D_Phi stays applied.
+//
+// On the same resonator, 1800 s, seed 1, the seed model alone was reported
+// valid worse than raw in two runs: a 1 deg phase lag, whose drift 2 nu phi
+// no model holds (21.4 deg/h against 6.49 raw), and a -2 % gain, whose
+// readout checks said 0 because the self-identification's decay test
+// refused one decay rate (64.1 against 18.2). Both are now not valid.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -119,6 +125,55 @@ TEST(Health, AGainTakenForDampingIsReportedWithItsFigureInTheReportTelemetryAndO
   DOUBLES_EQUAL(0.0, bus.column("comp_valid")[end], 0.0);
   std::remove(opt.can_log.c_str());
   std::remove(o.out_path.c_str());
+}
+
+TEST(Health, AOneDegreePhaseLagLeftInTheReadoutMakesTheSeedModelNotValid) {
+  // GIVEN the 4.2 kHz resonator with a 1 deg y pickoff phase, no calibration,
+  // 1800 s, seed 1: the seed's model alone was reported valid at 21.4 deg/h
+  // against 6.49 raw (its check window's misfit 0.372, inside 1/4 ... 4)
+  RunConfig j = other_resonator(1800.0);
+  j.sim.effects.pickoff_phase_mismatch.enabled = true;
+  j.sim.effects.pickoff_phase_mismatch.phase_deg = 1.0;
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
+  std::printf("\n  phase 1 deg: %.1f sigma, drift share %.3f, reasons 0x%02x",
+              r.readout_phase_sigmas, r.readout_phase_drift_share, r.compensation_reasons);
+  // THEN the self-identification's phase stands thousands of sigmas out and
+  // its drift 2 nu phi (5.76e-5 rad/s) is more than the model's |dnu|
+  // (4.95e-5 1/s): share 1.16, above 1/2
+  CHECK(r.readout_phase_sigmas > 1000.0);
+  DOUBLES_EQUAL(1.16, r.readout_phase_drift_share, 0.05);
+  // AND the compensation is never valid, for that reason, in the report too
+  CHECK_FALSE(r.compensation_valid);
+  const uint8_t phase = reason_bit(CompensationReason::readout_phase_drift);
+  LONGS_EQUAL(phase, r.compensation_reasons & phase);
+  const std::string json = hrg::sim_run::report_json(j, r);
+  CHECK(json.find("\"readout_phase_drift\"") != std::string::npos);
+  DOUBLES_EQUAL(r.readout_phase_drift_share, report_number(json, "readout_phase_drift_share"),
+                1e-6);
+}
+
+TEST(Health, AGainOfMinusTwoPercentIsSeenWhereTheDecayTestRefusesOneDecayRate) {
+  // GIVEN the 4.2 kHz resonator with a -2 % y pickoff gain, no calibration,
+  // 1800 s, seed 1: the self-identification's decay test refuses one decay
+  // rate across the windows (F 1.98 > 1.70), and the readout checks said 0
+  // there: the seed's model was reported valid at 64.1 deg/h against 18.2 raw
+  RunConfig j = other_resonator(1800.0);
+  j.sim.effects.pickoff_gain_mismatch.enabled = true;
+  j.sim.effects.pickoff_gain_mismatch.gain = -0.02;
+  const RunResult r = hrg::sim_run::run_simulation(j, {});
+  std::printf("\n  gain -0.02: decay F %.2f, readout %.1f / %.0f sigma, reasons 0x%02x",
+              r.self_calibration.decay_f, r.readout_damping_sigmas, r.readout_pattern_sigmas,
+              r.compensation_reasons);
+  CHECK_FALSE(r.self_calibration.decay_consistent);
+  // THEN the fit with a decay rate per window reads the gain thousands of
+  // sigmas out, and the model's dnu_S (-1.19e-4 1/s) many sigmas from its
+  // (4.8e-5; truth 4.87e-5)
+  CHECK(r.readout_pattern_sigmas > 1000.0);
+  CHECK(r.readout_damping_sigmas > 2.0 * j.firmware.gyro.max_readout_damping_sigmas);
+  // AND the compensation is not valid: the readout is in the damping
+  CHECK_FALSE(r.compensation_valid);
+  const uint8_t damping = reason_bit(CompensationReason::readout_in_damping);
+  LONGS_EQUAL(damping, r.compensation_reasons & damping);
 }
 
 TEST(Health, TheGapsDPhiStaysAppliedOnTheOtherResonator) {

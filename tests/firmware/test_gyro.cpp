@@ -402,3 +402,37 @@ TEST(Gyro, TheReadoutsOwnPatternWithholdsDPhiAndTheStatusSaysWhy) {
   LONGS_EQUAL(0, g.status().compensation_reasons);
   CHECK(g.status().compensation_valid);
 }
+
+TEST(Gyro, AReadoutPhaseWhoseDriftCouldOutweighTheCompensationMakesItNotValid) {
+  using hrg::fw::CompensationReason;
+  using hrg::fw::reason_bit;
+  auto cfg = test_config();
+  cfg.identify = false;  // a model from calibration: in force once solved, no check windows
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, cfg);
+  CHECK(run_until(g, Mode::operate) > 0);
+  ident.health_.solved = true;
+  // GIVEN a phase lag 31000 sigmas out whose drift 2 nu phi is 0.4 of the
+  // model's (the compensated output cannot be worse than raw)
+  ident.health_.readout_phase_sigmas = 31000.0;
+  ident.health_.readout_phase_drift_share = 0.4;
+  run(g, 100);
+  // THEN the compensation stays valid
+  CHECK(g.status().compensation_valid);
+  LONGS_EQUAL(0, g.status().compensation_reasons);
+  // WHEN its drift is more than half the model's (1 deg on the 4.2 kHz
+  // resonator of tools/gregory/README.md: 1.16)
+  ident.health_.readout_phase_drift_share = 1.16;
+  run(g, 100);
+  // THEN not valid, and said why, on the status and the bus
+  const uint8_t phase = reason_bit(CompensationReason::readout_phase_drift);
+  CHECK_FALSE(g.status().compensation_valid);
+  LONGS_EQUAL(phase, g.status().compensation_reasons);
+  LONGS_EQUAL(phase, g.telemetry().comp_reasons);
+  CHECK_FALSE(g.telemetry().comp_valid);
+  // WHEN the phase stands within 5 sigmas (noise, whatever its share)
+  ident.health_.readout_phase_sigmas = 4.9;
+  run(g, 100);
+  // THEN valid again
+  CHECK(g.status().compensation_valid);
+  LONGS_EQUAL(0, g.status().compensation_reasons);
+}

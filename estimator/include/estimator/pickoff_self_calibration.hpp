@@ -105,6 +105,19 @@ struct PickoffSelfCalResult {
   double decay_f = 0.0;        // the per-window decay test's F (1 when one nu holds)
   double decay_f_limit = 0.0;  // what it passes up to
   bool decay_consistent = false;
+  // The decay test's own fit (a decay rate per window): the level patterns
+  // and the damping anisotropy with their 1 sigma from its residual. A
+  // damping that changes between windows goes into the windows' own rates
+  // there and cannot read as a level pattern, so these stand where the
+  // decay test refuses the common-nu figures above.
+  double per_window_gain = 0.0;
+  double per_window_gain_sigma = 0.0;
+  double per_window_misalignment_rad = 0.0;
+  double per_window_misalignment_sigma_rad = 0.0;
+  double per_window_dnu_c_per_s = 0.0;
+  double per_window_dnu_s_per_s = 0.0;
+  double per_window_dnu_c_sigma_per_s = 0.0;
+  double per_window_dnu_s_sigma_per_s = 0.0;
   int windows = 0;
   int turning_windows = 0;  // windows whose 4theta moved by kSelfCalMinTurnRad or more
   int samples = 0;
@@ -196,5 +209,23 @@ double damping_anisotropy_disagreement_sigmas(const PickoffSelfCalResult& r, con
 // amplitude; the phase lag reads as a split instead). 0 under the same
 // conditions as above (solve not ok, or more than one decay rate).
 double readout_pattern_sigmas(const PickoffSelfCalResult& r);
+
+// How many of its own standard errors the readout's phase lag stands from
+// none, |phi| / sigma_phi; 0 unless `r` is ok. The quadrature row that reads
+// it holds no decay rate, so one decay rate need not hold.
+double readout_phase_sigmas(const PickoffSelfCalResult& r);
+
+// The drift a pickoff phase lag phi left uncorrected adds, against the drift
+// a model p removes: 2 nu |phi| over |(dnu_C, dnu_S)|, both amplitudes of a
+// 4 theta pattern in Omega K units (0 when p has no anisotropy; `r` not ok:
+// 0). The loops act on the rotated readout: the pump follows a vibration
+// phase off by ~ -phi sin^2 2theta, and the pattern drifts by 2 nu phi
+// (measured: phi 1 deg on the 4.2 kHz resonator of tools/gregory/README.md,
+// nu 1.649e-3 1/s, the seed model's ADB 21.4 deg/h = 5.75e-5 rad/s x K
+// against 2 nu phi 5.76e-5). The model has no such term: its compensated
+// output keeps it, and the raw output holds it beside the anisotropy's
+// drift, so the compensated output can be worse than raw only when this
+// share exceeds 1/2.
+double readout_phase_drift_share(const PickoffSelfCalResult& r, const ParamVector& p);
 
 }  // namespace hrg::est

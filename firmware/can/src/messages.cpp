@@ -52,8 +52,8 @@ constexpr SignalDef kStatus[] = {
   {"faults", 16, 16, false, 1, 0, 0, 65535, ""},
   {"temp_c", 32, 16, true, 0.01, 0, -327.68, 327.67, "degC"},
   {"seq", 48, 8, false, 1, 0, 0, 255, ""},
-  // fw::CompensationReason bits (compensation_reason.hpp): 7 used.
-  {"comp_reasons", 56, 8, false, 1, 0, 0, 127, ""},
+  // fw::CompensationReason bits (compensation_reason.hpp): all 8 used.
+  {"comp_reasons", 56, 8, false, 1, 0, 0, 255, ""},
 };
 constexpr SignalDef kEstDamping[] = {
   {"nu_per_s", 0, 24, false, 1e-8, 0, 0, 16777215.0 * 1e-8, "1/s"},

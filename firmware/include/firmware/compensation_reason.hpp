@@ -24,14 +24,20 @@ enum class CompensationReason : uint8_t {
   // explains what its fits read. The compensation is not valid with it only
   // while the pump's part of D_Phi is in use (a measured drift withheld).
   control_drift_withheld = 1u << 6,
+  // The pickoff self-identification reads a phase lag the correction in
+  // force leaves, whose own drift (2 nu phi, a 4 theta pattern in no model)
+  // is more than half the drift the model removes: the compensated output
+  // may then be worse than raw.
+  readout_phase_drift = 1u << 7,
 };
-inline constexpr int kCompensationReasonBits = 7;
+inline constexpr int kCompensationReasonBits = 8;
 
 constexpr uint8_t reason_bit(CompensationReason r) { return static_cast<uint8_t>(r); }
 
 // The bits' names, bit 0 first (reports, recordings' readers).
 inline constexpr std::array<const char*, kCompensationReasonBits> kCompensationReasonNames = {
-    "not_in_force",       "check_failed",       "not_checked",           "pump_edge_step",
-    "control_drift_lost", "readout_in_damping", "control_drift_withheld"};
+    "not_in_force",           "check_failed",       "not_checked",
+    "pump_edge_step",         "control_drift_lost", "readout_in_damping",
+    "control_drift_withheld", "readout_phase_drift"};
 
 }  // namespace hrg::fw

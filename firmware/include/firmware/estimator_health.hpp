@@ -30,6 +30,13 @@ struct EstimatorHealth {
   // the same conditions): the readout's own 4 theta pattern in the measured
   // amplitude, which the D_Phi fits would read as drift.
   double readout_pattern_sigmas = 0.0;
+  // The pickoff self-identification's phase lag: standard errors from zero
+  // (est::readout_phase_sigmas), and the drift it adds, 2 nu |phi|, over the
+  // model's anisotropy drift (est::readout_phase_drift_share; 0 without a
+  // model). A phase the correction in force leaves drifts the output by a
+  // 4 theta pattern no model holds.
+  double readout_phase_sigmas = 0.0;
+  double readout_phase_drift_share = 0.0;
   // The pump's part of D_Phi is in use (its online fit usable, or a known
   // gap standing in for it): withholding D_Phi then withholds a drift.
   bool pump_drift_in_use = false;

@@ -28,6 +28,9 @@ class EstimatorPort final : public ResonatorIdentifier {
     h.control_drift_lost = est_.pump_drift_lost();
     h.readout_damping_sigmas = readout_damping_sigmas();
     h.readout_pattern_sigmas = est::readout_pattern_sigmas(self_cal_result_);
+    h.readout_phase_sigmas = est::readout_phase_sigmas(self_cal_result_);
+    h.readout_phase_drift_share =
+        est_.has_model() ? est::readout_phase_drift_share(self_cal_result_, est_.model()) : 0.0;
     h.pump_drift_in_use = est_.pump_drift().usable() || est_.known_gap_in_use();
     return h;
   }

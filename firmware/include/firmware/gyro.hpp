@@ -65,6 +65,15 @@ struct GyroConfig {
   // fit takes for a gap harmonic (0.18-0.36 at g 0.01 on the 4.2 kHz
   // resonator of tools/gregory/README.md). 0: not checked.
   double max_readout_pattern_sigmas = 5.0;
+  // ... and not while the pickoff self-identification reads a phase lag
+  // more than this many standard errors from zero (EstimatorHealth::
+  // readout_phase_sigmas; the correction in force, if any, already taken
+  // out) whose drift 2 nu |phi| is more than max_readout_phase_drift_share of
+  // the drift the model removes (EstimatorHealth::readout_phase_drift_share):
+  // the model has no such drift, the raw output holds both, so beyond 1/2
+  // the compensated output may be worse than raw. 0: not checked.
+  double max_readout_phase_sigmas = 5.0;
+  double max_readout_phase_drift_share = 0.5;
   // Do no harm while the pump runs: the step of the corrected signal at
   // every switch-off (PumpEdgeCheck). A step above its tolerance makes the
   // compensation not valid.

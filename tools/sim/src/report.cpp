@@ -304,6 +304,16 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.number("decay_f", s.decay_f);
   w.number("decay_f_limit", s.decay_f_limit);
   w.boolean("decay_consistent", s.decay_consistent);
+  // The decay test's fit (a decay rate per window), the readout checks'
+  // figures where the test refuses the common one.
+  w.number("per_window_gain", s.per_window_gain);
+  w.number("per_window_gain_sigma", s.per_window_gain_sigma);
+  w.number("per_window_misalignment_deg", s.per_window_misalignment_rad / kDegRad);
+  w.number("per_window_misalignment_sigma_deg", s.per_window_misalignment_sigma_rad / kDegRad);
+  w.number("per_window_dnu_c_per_s", s.per_window_dnu_c_per_s);
+  w.number("per_window_dnu_s_per_s", s.per_window_dnu_s_per_s);
+  w.number("per_window_dnu_c_sigma_per_s", s.per_window_dnu_c_sigma_per_s);
+  w.number("per_window_dnu_s_sigma_per_s", s.per_window_dnu_s_sigma_per_s);
   w.number("residual_rms", s.residual_rms);
   w.integer("windows", s.windows);
   w.integer("turning_windows", s.turning_windows);
@@ -331,6 +341,8 @@ void compensation_health_json(JsonWriter& w, const RunResult& r) {
   w.end_array();
   w.number("readout_damping_sigmas", r.readout_damping_sigmas);
   w.number("readout_pattern_sigmas", r.readout_pattern_sigmas);
+  w.number("readout_phase_sigmas", r.readout_phase_sigmas);
+  w.number("readout_phase_drift_share", r.readout_phase_drift_share);
   w.begin_object("control_drift");
   const auto withheld = fw::reason_bit(fw::CompensationReason::control_drift_withheld);
   w.boolean("valid", (r.compensation_reasons & withheld) == 0);

@@ -473,6 +473,8 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.compensation_reasons = gyro.status().compensation_reasons;
   r.readout_damping_sigmas = gyro.status().readout_damping_sigmas;
   r.readout_pattern_sigmas = health.readout_pattern_sigmas;
+  r.readout_phase_sigmas = health.readout_phase_sigmas;
+  r.readout_phase_drift_share = health.readout_phase_drift_share;
   const est::PumpDriftEstimator& pump = firmware->estimator().estimator().pump_drift();
   r.pump_gap = pump.gap();
   r.pump_gap_sigmas = pump.gap_sigmas();

@@ -192,10 +192,13 @@ struct RunResult {
   double last_window_misfit = 0.0;
   // Why not valid at the end (fw::CompensationReason bits), the model check
   // against the readout's pattern, the readout pattern's own significance,
-  // and the pump's D_Phi fit (its gap harmonic, how many sigmas, usable).
+  // the readout phase's significance and drift share, and the pump's D_Phi
+  // fit (its gap harmonic, how many sigmas, usable).
   uint8_t compensation_reasons = 0;
   double readout_damping_sigmas = 0.0;
   double readout_pattern_sigmas = 0.0;
+  double readout_phase_sigmas = 0.0;
+  double readout_phase_drift_share = 0.0;
   double pump_gap = 0.0;
   double pump_gap_sigmas = 0.0;
   bool pump_drift_usable = false;
