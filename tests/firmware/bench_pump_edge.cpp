@@ -19,6 +19,7 @@
 #include "firmware/estimator_port.hpp"
 #include "firmware/gyro.hpp"
 #include "firmware/pump_edge_check.hpp"
+#include "support/short_window_config.hpp"
 
 using hrg::fw::ChainRecord;
 using hrg::fw::PumpEdgeCheck;
@@ -62,14 +63,7 @@ int run_to_model(hrg::fw::Gyro& g) {
 }
 
 hrg::fw::GyroConfig model_check_config(bool refuse) {
-  hrg::fw::GyroConfig c;
-  c.settle_frames = 20;
-  c.windows.length_frames = 200;
-  c.windows.period_frames = 300;
-  c.windows.bins = 16;
-  c.windows.windows_per_bin = 100;
-  c.windows.max_wait_frames = 300;
-  c.windows.rotate_on_static_base = false;
+  hrg::fw::GyroConfig c = hrg::test::short_window_config();
   c.windows.check_period_frames = 2000;
   // Every check window's misfit below this: refused.
   if (refuse) c.min_window_misfit = 1e9;

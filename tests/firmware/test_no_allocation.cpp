@@ -15,24 +15,11 @@
 #include "firmware/gyro.hpp"
 
 #include "support/cpputest.hpp"
+#include "support/short_window_config.hpp"
 
 using hrg::fw::Gyro;
 using hrg::fw::Mode;
 using hrg::fw::Pacing;
-
-namespace {
-hrg::fw::GyroConfig config() {
-  hrg::fw::GyroConfig c;
-  c.settle_frames = 20;
-  c.windows.length_frames = 200;
-  c.windows.period_frames = 300;
-  c.windows.bins = 16;
-  c.windows.windows_per_bin = 100;
-  c.windows.max_wait_frames = 300;
-  c.windows.rotate_on_static_base = false;
-  return c;
-}
-}  // namespace
 
 TEST_GROUP(CountingNewAllocator){};
 
@@ -57,7 +44,7 @@ TEST(NoAllocation, TheGyroWithTheDspChainAllocatesNothingPerFrame) {
   cc.adc_full_scale_v = 2.5;
   hrg::fw::DspChainPort chain(cc);
   hrg::fakes::FakeResonatorIdentifier ident;
-  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, config());
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, hrg::test::short_window_config());
   counter.install();
   Eigen::internal::set_is_malloc_allowed(false);
   for (int i = 0; i < 3000; ++i)
@@ -74,7 +61,7 @@ TEST(NoAllocation, TheGyroWithTheEstimatorAllocatesNothingThroughWindowsAndSolve
   chain.decay_per_block = 3e-6;           // nu = 3e-3 1/s at 1 kHz
   hrg::est::Estimator::Config ec;
   hrg::fw::EstimatorPort ident(ec);
-  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, config());
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, hrg::test::short_window_config());
   counter.install();
   Eigen::internal::set_is_malloc_allowed(false);
   for (int i = 0; i < 6000; ++i)
@@ -99,7 +86,7 @@ TEST(NoAllocation, TheDampingModelCheckAndTheSeedModelBesideItAllocateNothing) {
   cal.nonlinear_damping_per_v2 = 0.05;
   ident.set_resonator_model(cal);
   CHECK(ident.seed_model_kept());
-  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, config());
+  Gyro g(b.board, chain, ident, timer, Pacing::lockstep, hrg::test::short_window_config());
   counter.install();
   Eigen::internal::set_is_malloc_allowed(false);
   for (int i = 0; i < 6000; ++i)
