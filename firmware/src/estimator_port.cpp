@@ -50,6 +50,7 @@ void EstimatorPort::set_resonator_model(const Calibration& cal) {
                             cal.temperature_ref_c == model_.temperature_ref_c &&
                             cal.nonlinear_damping_per_v2 == model_.nonlinear_damping_per_v2;
   model_ = cal;
+  refresh_readout_figures();  // the damping check's rule reads model_
   if (same_damping) return;
   model_check_.reset();
   model_check_result_ = {};
@@ -67,6 +68,7 @@ void EstimatorPort::fall_back_to_seed_model() {
   dirty_ = true;  // solved again at the next solve()
   health_.window_misfit = est_.last_window_misfit();
   health_.windows_checked = est_.windows_checked();
+  refresh_readout_figures();
 }
 
 void EstimatorPort::restart_model() {
@@ -75,6 +77,7 @@ void EstimatorPort::restart_model() {
   health_ = {};
   dirty_ = false;
   last_control_t_s_ = -1.0;
+  refresh_readout_figures();
 }
 
 void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& applied) {
@@ -82,6 +85,7 @@ void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& ap
   self_cal_.refer_to_applied(applied);
   self_cal_result_ = {};
   self_cal_dirty_ = true;  // the re-referred residual, solved at the next solve()
+  refresh_readout_figures();
   // The windows' levels changed with the correction, their decay did not:
   // the damping model check keeps them.
 }
@@ -177,6 +181,11 @@ void EstimatorPort::solve() {
     check_dirty_ = false;
     model_check_result_ = model_check_.solve();
   }
+  solve_model();
+  refresh_readout_figures();
+}
+
+void EstimatorPort::solve_model() {
   if (!dirty_) return;
   dirty_ = false;
   if (shadow_) (void)seed_est_.solve_and_accept();
@@ -189,6 +198,14 @@ void EstimatorPort::solve() {
   for (double c : cov)
     covered += c > 0.0 ? 1 : 0;
   health_.coverage = static_cast<double>(covered) / static_cast<double>(cov.size());
+}
+
+void EstimatorPort::refresh_readout_figures() {
+  health_.readout_damping_sigmas = readout_damping_sigmas();
+  health_.readout_pattern_sigmas = est::readout_pattern_sigmas(self_cal_result_);
+  health_.readout_phase_sigmas = est::readout_phase_sigmas(self_cal_result_);
+  health_.readout_phase_drift_share =
+      est_.has_model() ? est::readout_phase_drift_share(self_cal_result_, est_.model()) : 0.0;
 }
 
 double EstimatorPort::readout_damping_sigmas() const {

@@ -14,8 +14,9 @@ namespace hrg::fw {
 // accepts the model when the conditioning allows, the drift is eq. 22.
 class EstimatorPort final : public ResonatorIdentifier {
  public:
-  explicit EstimatorPort(const est::Estimator::Config& cfg)
-      : cfg_(cfg), est_(cfg), seed_est_(cfg) {}
+  explicit EstimatorPort(const est::Estimator::Config& cfg) : cfg_(cfg), est_(cfg), seed_est_(cfg) {
+    refresh_readout_figures();
+  }
 
   void begin_window(double t_s) override;
   void add_sample(const ChainRecord& s) override;
@@ -23,14 +24,11 @@ class EstimatorPort final : public ResonatorIdentifier {
   void end_check_window() override;
   void abort_window() override;
   void solve() override;
+  // Read every output frame: the readout figures in health_ are refreshed
+  // where what they are computed from changes (refresh_readout_figures).
   EstimatorHealth health() const override {
     EstimatorHealth h = health_;
     h.control_drift_lost = est_.pump_drift_lost();
-    h.readout_damping_sigmas = readout_damping_sigmas();
-    h.readout_pattern_sigmas = est::readout_pattern_sigmas(self_cal_result_);
-    h.readout_phase_sigmas = est::readout_phase_sigmas(self_cal_result_);
-    h.readout_phase_drift_share =
-        est_.has_model() ? est::readout_phase_drift_share(self_cal_result_, est_.model()) : 0.0;
     h.pump_drift_in_use = est_.pump_drift().usable() || est_.known_gap_in_use();
     return h;
   }
@@ -111,6 +109,13 @@ class EstimatorPort final : public ResonatorIdentifier {
  private:
   // EstimatorHealth::readout_damping_sigmas of the model in force.
   double readout_damping_sigmas() const;
+  // The readout checks' figures into health_. They depend on the model in
+  // force, its solution, the self-calibration's result and the damping
+  // model only, so they are computed where one of those changes (a solve,
+  // a restart, a new resonator model, the fall-back), not every frame.
+  void refresh_readout_figures();
+  // The seed's model (and its shadow) solved again if a window came in.
+  void solve_model();
   void end_side_windows();
   // The damping scale of the thermal probe at the measured temperature.
   double probe_scale() const;
