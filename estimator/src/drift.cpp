@@ -333,28 +333,35 @@ bool gap_harmonic(const Eigen::Matrix4d& m, Eigen::Vector2d& g) {
 
 double PumpDriftEstimator::gap_sigmas() const { return gap_sigmas_; }
 
-double PumpDriftEstimator::gap_sigmas_from(const Eigen::Vector2d& g0) const {
-  if (!valid() || segments_ < 2 * kBatches) return 0.0;
-  Eigen::Vector2d g;
-  if (!gap_harmonic(with_model(m_), g)) return 0.0;
+bool PumpDriftEstimator::gap_fit(Eigen::Vector2d& g, Eigen::Matrix2d& cov) const {
+  if (!valid() || segments_ < 2 * kBatches) return false;
+  if (!gap_harmonic(with_model(m_), g)) return false;
   std::array<Eigen::Vector2d, kBatches> gb;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (int j = 0; j < kBatches; ++j) {
     if (!gap_harmonic(with_model(batch_[static_cast<std::size_t>(j)]),
                       gb[static_cast<std::size_t>(j)]))
-      return 0.0;
+      return false;
     mean += gb[static_cast<std::size_t>(j)] / kBatches;
   }
   // Covariance of the full fit ~ that of the mean of the batch fits, plus
   // what the model's own uncertainty moves the fit by (model_shift()).
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  cov.setZero();
   for (const Eigen::Vector2d& x : gb)
     cov += (x - mean) * (x - mean).transpose();
   cov /= static_cast<double>(kBatches) * (kBatches - 1);
   const Eigen::Matrix<double, 2, kParams> a = model_shift();
   cov += a * p_cov_ * a.transpose();
+  return true;
+}
+
+double PumpDriftEstimator::gap_sigmas_from(const Eigen::Vector2d& g0,
+                                           const Eigen::Matrix2d& g0_covariance) const {
+  Eigen::Vector2d g;
+  Eigen::Matrix2d cov;
+  if (!gap_fit(g, cov)) return 0.0;
   const Eigen::Vector2d dg = g - g0;
-  const double m2 = dg.dot(cov.ldlt().solve(dg));
+  const double m2 = dg.dot((cov + g0_covariance).ldlt().solve(dg));
   return m2 > 0.0 && std::isfinite(m2) ? std::sqrt(m2) : 0.0;
 }
 

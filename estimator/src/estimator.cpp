@@ -41,10 +41,14 @@ void Estimator::check_known_gap() {
   if (!config_.gap.known() || gap_refuted_ || pump_.fit_s() == gap_checked_fit_s_) return;
   gap_checked_fit_s_ = pump_.fit_s();
   if (!pump_.valid()) return;
-  const double b0 = pump_.coefficients()(0);
-  const Eigen::Vector2d g0(0.5 * b0 * config_.gap.eps_p, 0.5 * b0 * config_.gap.eps_q);
+  // In the fit's units, (b1, b2) = b0 (eps_p, eps_q) / 2.
+  const double half_b0 = 0.5 * pump_.coefficients()(0);
+  const Config::KnownGap& k = config_.gap;
+  const Eigen::Vector2d g0(half_b0 * k.eps_p, half_b0 * k.eps_q);
+  const Eigen::Vector2d s0(half_b0 * k.sigma_eps_p, half_b0 * k.sigma_eps_q);
+  const Eigen::Matrix2d c0 = s0.cwiseProduct(s0).asDiagonal();
   const double min_sigmas = config_.pump.min_gap_sigmas;
-  if (min_sigmas > 0.0 && pump_.gap_sigmas_from(g0) >= min_sigmas) gap_refuted_ = true;
+  if (min_sigmas > 0.0 && pump_.gap_sigmas_from(g0, c0) >= min_sigmas) gap_refuted_ = true;
 }
 
 Solution Estimator::solve_and_accept() {

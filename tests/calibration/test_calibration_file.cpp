@@ -46,6 +46,20 @@ TEST(CalibrationFile, KeysCarryTheirUnitAndAnglesAreDegreesAtThisEdge) {
   DOUBLES_EQUAL(0.0, f.calibration.pickoff_y_misalignment_rad, 0.0);  // left out: identity
 }
 
+TEST(CalibrationFile, TheGapsSigmasAreTheFilesAndZeroWhereNotGiven) {
+  // The firmware weighs them with its online pump fit (Estimator::check_known_gap).
+  const CalibrationFile f = parse_calibration(
+      "calibration_format = 1\ngap_eps_p = -0.0159\ngap_eps_p_sigma = 0.0013\n"
+      "gap_eps_q = 0.0197\npickoff_y_gain_sigma = 7e-5\n",
+      "gyro.toml");
+  const GapSigma s = gap_sigma(f);
+  DOUBLES_EQUAL(0.0013, s.eps_p, 0.0);
+  DOUBLES_EQUAL(0.0, s.eps_q, 0.0);
+  const GapSigma none = gap_sigma(CalibrationFile{});
+  DOUBLES_EQUAL(0.0, none.eps_p, 0.0);
+  DOUBLES_EQUAL(0.0, none.eps_q, 0.0);
+}
+
 TEST(CalibrationFile, SavedFileLoadsBackToTheSameCalibrationAndItsCrc) {
   CalibrationFile f;
   f.calibration.pickoff_y_gain = 0.0101234567890123;

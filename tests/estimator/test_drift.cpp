@@ -336,10 +336,15 @@ struct PumpedRing {
   double window_s = 5.0;
   double turn_rad_s = 0.2;
   double t = 0.0, a_A = 1.0, th = 0.0;
+  // A thermal damping: the whole damping times k = 1 + thermal_share cos(thermal_rad_s t)
+  // (beta times the temperature's swing); the samples carry k when it is known.
+  double thermal_share = 0.0, thermal_rad_s = 0.0;
+  bool thermal_known = true;
   std::vector<double> w_written;
 
+  double damping_scale() const { return 1.0 + thermal_share * std::cos(thermal_rad_s * t); }
   double pump_v() const {
-    const double balance = std::sqrt(p(kNu) / (c * std::cos(eps)));
+    const double balance = std::sqrt(damping_scale() * p(kNu) / (c * std::cos(eps)));
     const double since_window_s = std::fmod(t, window_s);
     return balance * (1.0 + 0.5 * std::exp(-since_window_s / 0.3) + 0.02 * std::sin(0.7 * t));
   }
@@ -356,12 +361,14 @@ struct PumpedRing {
       }
       const double v0 = pump_v();
       w_written.push_back(v0 * v0 * std::cos(eps));
-      all_taken = est.add_sample({t, a_A, 0.0, th, eps, 0, 0, v0}) && all_taken;
+      const double k = damping_scale();
+      all_taken =
+          est.add_sample({t, a_A, 0.0, th, eps, 0, 0, v0, thermal_known ? k : 1.0}) && all_taken;
       const std::size_t n = w_written.size();
       const double w_acting = n > static_cast<std::size_t>(lag) ? w_written[n - 1 - lag] : 0.0;
       const double c4 = std::cos(4 * th), s4 = std::sin(4 * th);
       const double dnu = p(kDnuC) * c4 + p(kDnuS) * s4;
-      a_A *= std::exp(dt * (-p(kNu) - dnu + c * w_acting * (1 + e_p * c4 + e_q * s4)));
+      a_A *= std::exp(dt * (-k * (p(kNu) + dnu) + c * w_acting * (1 + e_p * c4 + e_q * s4)));
       th += turn_rad_s * dt;
       t += dt;
     }
@@ -479,4 +486,111 @@ TEST(ControlDrift, ALostPumpDriftIsReported) {
   CHECK_FALSE(est.pump_drift().usable());
   DOUBLES_EQUAL(0.0, est.pump_d_phi_rad_s(0.3), 0.0);
   CHECK(est.pump_drift_lost());
+}
+
+namespace {
+// The pump fit of a noisy turning pattern (1e-6 V on the amplitude) beside
+// a known gap: the estimator with an accepted model and the gap given.
+struct KnownGapTrial {
+  ParamVector p = seed_params(12 * M_PI / 180, 31 * M_PI / 180);
+  Estimator est{config()};
+  static Estimator::Config config() {
+    Estimator::Config cfg;
+    cfg.pump.pump_lag_samples = 3;
+    cfg.pump.max_kappa_2 = 10.0;
+    return cfg;
+  }
+  // Runs the ring for duration_s; the gap fit's (b1, b2) and covariance.
+  void run(const Estimator::Config::KnownGap& gap, double duration_s) {
+    std::mt19937_64 rng(1);
+    fold_spread_windows(est, p, rng);
+    CHECK(est.solve_and_accept().accepted());
+    est.set_known_gap(gap);
+    PumpedRing ring;
+    ring.p = est.model();
+    ring.t = 200.0;
+    std::normal_distribution<double> noise(0.0, 1e-6);
+    struct Noisy {
+      Estimator& e;
+      std::mt19937_64& rng;
+      std::normal_distribution<double>& n;
+      void restart() { e.restart_control(); }
+      bool add_sample(PumpDriftEstimator::Sample s) {
+        s.a_A_v += n(rng);
+        return e.add_control_sample(s);
+      }
+    };
+    CHECK(ring.run(duration_s, Noisy{est, rng, noise}));
+  }
+  // The fit's eps_p and its sigma.
+  void fit_eps_p(double& eps_p, double& sigma) const {
+    Eigen::Vector2d g;
+    Eigen::Matrix2d cov;
+    CHECK(est.pump_drift().gap_fit(g, cov));
+    const double b0 = est.pump_drift().coefficients()(0);
+    eps_p = 2.0 * g(0) / b0;
+    sigma = 2.0 * std::sqrt(cov(0, 0)) / b0;
+  }
+};
+}  // namespace
+
+TEST(ControlDrift, AKnownGapIsCheckedInTheUncertaintyOfBothMeasurements) {
+  // GIVEN the ring's gap (eps_p, eps_q) = 2 (e_p, e_q) = (0.02, -0.008)
+  // measured by a calibration 1e-4 off in eps_p with a sigma of 1.25e-4
+  // (0.8 of its sigma: a fair draw), while the online fit of 400 s reads it
+  // far more precisely (the Gregory gap + thermal damping row at seed 2: 0.7 of
+  // the file's sigma, 14 of the fit's)
+  const double off = 1.0e-4, sigma = 1.25e-4;
+  PumpedRing ring;
+  const double eps_p = 2.0 * ring.e_p, eps_q = 2.0 * ring.e_q;
+  KnownGapTrial exact, weighed, wrong_sign;
+  exact.run({eps_p + off, eps_q}, 400.0);
+  weighed.run({eps_p + off, eps_q, sigma, sigma}, 400.0);
+  wrong_sign.run({-eps_p, -eps_q, sigma, sigma}, 400.0);
+  double fit = 0.0, fit_sigma = 0.0;
+  weighed.fit_eps_p(fit, fit_sigma);
+  std::printf("\n  online eps_p %.6f +- %.1e (true %.4f); the file's %.4f +- %.2e\n", fit,
+              fit_sigma, eps_p, eps_p + off, sigma);
+  // THEN the fit is at the truth (as PumpFitIntegratesThePumpThatActedOnTheRow)
+  // and the file stands more than 6.5 of the fit's own sigmas from it (what
+  // refuted it when its sigma was left out) ...
+  DOUBLES_EQUAL(eps_p, fit, 2e-4);
+  CHECK(fit_sigma < sigma / 10.0);
+  CHECK(std::fabs(fit - eps_p - off) > 6.5 * fit_sigma);
+  CHECK(exact.est.known_gap_refuted());
+  // ... but within 1 of the difference's (both sigmas): the file's gap is kept
+  CHECK_FALSE(weighed.est.known_gap_refuted());
+  // AND a gap of the wrong sign (320 of the file's sigmas off) is still refuted
+  CHECK(wrong_sign.est.known_gap_refuted());
+}
+
+TEST(ControlDrift, PumpFitTakesAKnownThermalDampingOutOfItsRows) {
+  // GIVEN a thermal damping of 0.4 % (0.004 /degC over +-1 degC) whose swing
+  // the pattern's turn follows (4 theta turning with the temperature's
+  // cycle: the worst case of a slow sweep), the AGC balancing it
+  PumpedRing known, unknown;
+  for (PumpedRing* r : {&known, &unknown}) {
+    r->thermal_share = 0.004;
+    r->thermal_rad_s = 4.0 * r->turn_rad_s;
+  }
+  unknown.thermal_known = false;
+  PumpDriftEstimator::Config cfg;
+  cfg.pump_lag_samples = known.lag;
+  PumpDriftEstimator with_k(cfg), without_k(cfg);
+  with_k.set_model(known.p);
+  without_k.set_model(unknown.p);
+  CHECK(known.run(60.0, with_k));
+  CHECK(unknown.run(60.0, without_k));
+  // THEN with the damping scale in the samples (a calibration's thermal
+  // model) the fit is at the truth, as without the effect ...
+  const Eigen::Vector3d b = with_k.coefficients();
+  DOUBLES_EQUAL(known.e_p, b(1) / b(0), 1e-4);
+  DOUBLES_EQUAL(known.e_q, b(2) / b(0), 1e-4);
+  // ... and without it the damping's swing reads as a gap harmonic in
+  // phase with it: e_p off by the damping's share, -nu beta A / (c w) = -0.004
+  // (the rows' known decay falls short where the damping is high)
+  const Eigen::Vector3d u = without_k.coefficients();
+  std::printf("\n  e_p with the thermal model %.5f, without %.5f (true %.4f)\n", b(1) / b(0),
+              u(1) / u(0), known.e_p);
+  DOUBLES_EQUAL(known.e_p - known.thermal_share, u(1) / u(0), 0.1 * known.thermal_share);
 }

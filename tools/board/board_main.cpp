@@ -198,7 +198,9 @@ int main(int argc, char** argv) {
   job.firmware.gyro.calibration_service.secret = o.cal_secret;
   if (!o.calibration.empty()) {
     try {
-      job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
+      const fw::CalibrationFile f = fw::load_calibration(o.calibration);
+      job.firmware.calibration = f.calibration;
+      job.firmware.calibration_gap_sigma = fw::gap_sigma(f);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "hrg-board: %s\n", e.what());
       return 2;

@@ -162,8 +162,11 @@ sim_run::RunConfig make_run(const SimOptions& o) {
       sim_run::make_run(o.scenario, {o.duration_s, o.bias_angles, o.static_base});
   job.firmware.gyro.compensate_control_drift = o.control_drift;
   job.firmware.online_pickoff_calibration = o.self_calibrate;
-  if (!o.calibration.empty())
-    job.firmware.calibration = fw::load_calibration(o.calibration).calibration;
+  if (!o.calibration.empty()) {
+    const fw::CalibrationFile f = fw::load_calibration(o.calibration);
+    job.firmware.calibration = f.calibration;
+    job.firmware.calibration_gap_sigma = fw::gap_sigma(f);
+  }
   return job;
 }
 

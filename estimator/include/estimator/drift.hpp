@@ -301,8 +301,14 @@ class PumpDriftEstimator {
   // valid() or while a batch fit is singular.
   double gap_sigmas() const;
   // The same significance for (b1, b2) - g0: how far the fit stands from a
-  // gap harmonic given elsewhere (a calibration's, as b0 (eps_p, eps_q)/2).
-  double gap_sigmas_from(const Eigen::Vector2d& g0) const;
+  // gap harmonic given elsewhere (a calibration's, as b0 (eps_p, eps_q)/2),
+  // whose own covariance g0_covariance (same units) adds to the fit's: the
+  // two are independent measurements. Zero: g0 taken as exact.
+  double gap_sigmas_from(const Eigen::Vector2d& g0,
+                         const Eigen::Matrix2d& g0_covariance = Eigen::Matrix2d::Zero()) const;
+  // (b1, b2) and the covariance gap_sigmas() weighs them with; false (both
+  // untouched or partly set) before valid() or while a batch fit is singular.
+  bool gap_fit(Eigen::Vector2d& g, Eigen::Matrix2d& cov) const;
   static constexpr int kBatches = 8;
   // valid(), gap() >= Config::min_gap and gap_sigmas() >= Config::
   // min_gap_sigmas: the pump's D_Phi is worth adding.

@@ -63,10 +63,14 @@ class Estimator {
     // then known_gap_drift_rad_s with the accepted model, from the first
     // model on, until the online fit is usable (it needs its own
     // significance, minutes of excitation). Both zero: not known, the online
-    // fit alone.
+    // fit alone. The sigmas are the calibration's own one-standard-deviation
+    // uncertainties (an audit's fit of a few minutes); 0: not given, the gap
+    // is checked as if exact.
     struct KnownGap {
       double eps_p = 0.0;
       double eps_q = 0.0;
+      double sigma_eps_p = 0.0;
+      double sigma_eps_q = 0.0;
       bool known() const { return eps_p != 0.0 || eps_q != 0.0; }
     };
     KnownGap gap{};
@@ -203,9 +207,10 @@ class Estimator {
   KnownGapDrift known_gap_;
   void check_window(const WindowContribution& w);
   // The known gap against the online fit, once per folded segment: refuted
-  // when the fit stands PumpDriftEstimator::Config::min_gap_sigmas of its own
-  // uncertainty away from it (a wrong sign stands out twice as fast as the
-  // gap itself becomes usable online).
+  // when the fit stands PumpDriftEstimator::Config::min_gap_sigmas away from
+  // it, in the uncertainty of the difference: the fit's and the gap's own
+  // (KnownGap's sigmas) together, two independent measurements (a wrong sign
+  // stands out twice as fast as the gap itself becomes usable online).
   void check_known_gap();
   bool gap_refuted_ = false;
   double gap_checked_fit_s_ = -1.0;

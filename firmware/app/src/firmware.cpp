@@ -84,9 +84,13 @@ bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource sourc
 }
 
 void Firmware::put_in_force(const Calibration& cal, bool electronics_changed) {
+  // The sigma belongs to the gap it was given with (the file's at start).
+  if (cal.gap_eps_p != cfg_.calibration.gap_eps_p || cal.gap_eps_q != cfg_.calibration.gap_eps_q)
+    cfg_.calibration_gap_sigma = {};
   cfg_.calibration = cal;
   estimator_.set_resonator_model(cal);
-  estimator_.set_known_gap(cal.gap_eps_p, cal.gap_eps_q);
+  const GapSigma& s = cfg_.calibration_gap_sigma;
+  estimator_.set_known_gap({cal.gap_eps_p, cal.gap_eps_q, s.eps_p, s.eps_q});
   // The switch-off steps of a signal corrected otherwise start again.
   if (electronics_changed) gyro_.restart_pump_edge_check();
 }

@@ -96,9 +96,10 @@ class EstimatorPort final : public ResonatorIdentifier {
   // (est::PickoffSelfCalibration::refer_to_applied).
   void restart_after_correction(const est::PickoffSelfCalResult& applied);
   // The gap harmonic a calibration gives (both zero: not known, fitted
-  // online). Kept across restart(); changes no window.
-  void set_known_gap(double eps_p, double eps_q) {
-    cfg_.gap = {eps_p, eps_q};
+  // online), with its own sigmas (0: not given). Kept across restart();
+  // changes no window.
+  void set_known_gap(const est::Estimator::Config::KnownGap& gap) {
+    cfg_.gap = gap;
     est_.set_known_gap(cfg_.gap);
     seed_est_.set_known_gap(cfg_.gap);
   }

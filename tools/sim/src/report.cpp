@@ -156,8 +156,8 @@ bool judge(const RunConfig& job, RunResult& r) {
   if (r.calibration.gap_refuted) {
     r.failures.push_back(
         fmt("the calibration's gap harmonic was refuted at %.1f s: the online fit of the "
-            "pump's drift stands %.1f of its sigmas or more away from it; the online fit "
-            "is used",
+            "pump's drift stands %.1f sigmas of the difference or more away from it (the "
+            "fit's and the file's own uncertainty together); the online fit is used",
             r.calibration.gap_refuted_s, job.firmware.estimator.pump.min_gap_sigmas));
   }
   if (r.pump_edge.verdict == fw::PumpEdgeVerdict::step) {
@@ -351,6 +351,10 @@ void compensation_health_json(JsonWriter& w, const RunResult& r) {
   w.boolean("pump_fit_usable", r.pump_drift_usable);
   w.number("pump_gap", r.pump_gap);
   w.number("pump_gap_sigmas", r.pump_gap_sigmas);
+  w.number("pump_eps_p", r.pump_eps_pq_sigma[0]);
+  w.number("pump_eps_q", r.pump_eps_pq_sigma[1]);
+  w.number("pump_eps_p_sigma", r.pump_eps_pq_sigma[2]);
+  w.number("pump_eps_q_sigma", r.pump_eps_pq_sigma[3]);
   w.end_object();
 }
 

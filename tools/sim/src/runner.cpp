@@ -2,6 +2,7 @@
 // The main job's runner: the firmware (firmware/app) on the simulated target,
 // in lockstep or paced in real time, with faults injected through the
 // target's back door and one telemetry row per 1 / telemetry_hz.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -325,6 +326,18 @@ void summarise_identification(RunResult& r, const RunConfig& job,
 }
 
 // The calling thread's CPU time (runs in parallel threads each count their own).
+// The pump fit's (eps_p, eps_q) = 2 (b1, b2) / b0 and their sigmas; zeros
+// before the fit is valid.
+std::array<double, 4> pump_eps_pq_sigma(const est::PumpDriftEstimator& pump) {
+  Eigen::Vector2d g;
+  Eigen::Matrix2d cov;
+  const double b0 = pump.coefficients()(0);
+  if (!(b0 > 0.0) || !pump.gap_fit(g, cov)) return {};
+  const double k = 2.0 / b0;
+  return {k * g(0), k * g(1), k * std::sqrt(std::max(cov(0, 0), 0.0)),
+          k * std::sqrt(std::max(cov(1, 1), 0.0))};
+}
+
 uint64_t thread_cpu_ns() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -478,6 +491,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   const est::PumpDriftEstimator& pump = firmware->estimator().estimator().pump_drift();
   r.pump_gap = pump.gap();
   r.pump_gap_sigmas = pump.gap_sigmas();
+  r.pump_eps_pq_sigma = pump_eps_pq_sigma(pump);
   r.pump_drift_usable = pump.usable();
   r.calibration = firmware->calibration_status();
   r.self_calibration = firmware->estimator().pickoff_self_calibration();

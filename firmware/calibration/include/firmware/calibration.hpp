@@ -47,6 +47,15 @@ struct Calibration {
   double gap_eps_q = 0.0;  // eps_q (-)
 };
 
+// One standard deviation of a calibration's gap harmonic (a file's
+// gap_eps_p_sigma, gap_eps_q_sigma; zero: not given, the gap is taken as
+// exact). Not part of the canonical form: a CAN block carries no sigma.
+// Est::Estimator weighs it with its online pump fit's (check_known_gap).
+struct GapSigma {
+  double eps_p = 0.0;
+  double eps_q = 0.0;
+};
+
 // One field: its key (unit in the name), its physical range, where it lives.
 struct CalibrationField {
   const char* key;

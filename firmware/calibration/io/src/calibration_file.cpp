@@ -107,6 +107,17 @@ double calibration_file_to_si(std::size_t field) {
   return is_angle(field) ? std::numbers::pi / 180.0 : 1.0;
 }
 
+GapSigma gap_sigma(const CalibrationFile& file) {
+  const auto sigma_of = [&file](double Calibration::*member) {
+    for (std::size_t i = 0; i < kCalibrationFieldCount; ++i) {
+      if (kCalibrationFields[i].member == member && std::isfinite(file.sigma[i]))
+        return file.sigma[i];
+    }
+    return 0.0;
+  };
+  return {sigma_of(&Calibration::gap_eps_p), sigma_of(&Calibration::gap_eps_q)};
+}
+
 CalibrationFile parse_calibration(std::string_view text, const std::string& source) {
   toml::table root;
   try {

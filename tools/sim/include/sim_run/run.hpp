@@ -201,6 +201,9 @@ struct RunResult {
   double readout_phase_drift_share = 0.0;
   double pump_gap = 0.0;
   double pump_gap_sigmas = 0.0;
+  // The fit's gap harmonic (eps_p, eps_q) and their one-sigma uncertainties
+  // (the covariance pump_gap_sigmas weighs with); 0 before the fit is valid.
+  std::array<double, 4> pump_eps_pq_sigma{};
   bool pump_drift_usable = false;
   // The calibration's trial (source, verdict, the misfits that judged it).
   fw::app::CalibrationStatus calibration{};

@@ -21,6 +21,10 @@ struct FirmwareConfig {
   // What the firmware corrects of this gyro's electronics (the identity by
   // default; a file, a CAN block or the built-in constant on bare metal).
   Calibration calibration = kIdentityCalibration;
+  // The uncertainty of `calibration`'s gap harmonic (a file's sigmas; zero:
+  // not given). A gap put in force later that differs from it (a CAN
+  // block's) comes without one.
+  GapSigma calibration_gap_sigma{};
   // The pickoff self-calibration's estimate (gain, misalignment) folded into
   // the correction in force when it is well conditioned and significant
   // (Firmware::self_calibrate); the identification then starts again.

@@ -40,6 +40,9 @@ struct CalibrationFile {
   CalibrationFile() { sigma.fill(std::numeric_limits<double>::quiet_NaN()); }
 };
 
+// The file's sigmas of gap_eps_p and gap_eps_q (0 where not given).
+GapSigma gap_sigma(const CalibrationFile& file);
+
 // The key of field i in the file (`_rad` -> `_deg`) and the factor from the
 // file's unit to the field's SI unit.
 std::string calibration_file_key(std::size_t field);
