@@ -211,31 +211,44 @@ int drop_transients(std::vector<EdgeJump>& jumps, std::vector<const Edge*>& used
   return dropped;
 }
 
-// Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
-// (the wave phase is defined modulo pi), minus its noise expectation. Fills
-// dchi2 and threshold; returns the mean of w^2 per pickoff.
+// Sign-free detection: the weighted mean of w^2 with w = J e^{-i phi} / V per
+// pickoff (the phase of the vibration is defined modulo pi), minus its noise
+// expectation. The noise of w is the jump's over the pump, v = var / V^2 per
+// part, so each edge's w^2 is weighed by the inverse of its noise variance (4 v^2), as the
+// least-squares estimate weighs its jumps by V^2 / var: equal weights let a
+// switch-off at a pump near zero (an amplitude loop just off its lower limit,
+// which holds no feedthrough to see) take the whole variance of the mean.
+// Fills dchi2 and threshold; returns the mean of w^2 per pickoff.
 std::array<cplx, 2> sign_free_detection(const std::vector<EdgeJump>& jumps, double ln_neff,
                                         FeedStat& fs) {
-  const auto n = static_cast<double>(jumps.size());
+  auto noise_of_w = [](const EdgeJump& ej) { return ej.var / (ej.pump_v * ej.pump_v); };
+  double weight_sum = 0.0;
+  for (const auto& ej : jumps)
+    weight_sum += 1.0 / (noise_of_w(ej) * noise_of_w(ej));
   std::array<cplx, 2> m{};
-  double s4 = 0.0;
   for (const auto& ej : jumps) {
     const cplx u = std::conj(ej.phasor) / ej.pump_v;
     const auto z = cplx2(ej.j);
-    const double v = ej.var / (ej.pump_v * ej.pump_v);
+    const double v = noise_of_w(ej);
+    const double a = 1.0 / (v * v * weight_sum);
     const Eigen::Matrix4d& pr = ej.proj;
     for (int k = 0; k < 2; ++k) {
       const cplx w = z[static_cast<std::size_t>(k)] * u;
       const cplx bias =
           v * cplx(pr(2 * k, 2 * k) - pr(2 * k + 1, 2 * k + 1), 2.0 * pr(2 * k, 2 * k + 1)) *
           std::conj(ej.phasor * ej.phasor);
-      m[static_cast<std::size_t>(k)] += (w * w - bias) / n;
+      m[static_cast<std::size_t>(k)] += a * (w * w - bias);
     }
-    s4 += 4.0 * v * v / n;
   }
-  const double var_m = 2.0 * s4 / n;
+  // The weighted mean's noise: sum of a^2 4 v^2 over the edges, which these
+  // weights make 4 / weight_sum (equal weights: the mean of 4 v^2 over n).
+  const double s4_over_n = 4.0 / weight_sum;
+  const double var_m = 2.0 * s4_over_n;
   fs.dchi2 = 2.0 * (std::norm(m[0]) + std::norm(m[1])) / var_m;
-  fs.threshold = std::pow(4.0 * ln_neff * s4 / n, 0.25);
+  fs.threshold = std::pow(4.0 * ln_neff * s4_over_n, 0.25);
+  if (std::getenv("HRG_AUDIT_DEBUG"))
+    std::fprintf(stderr, "feedthrough sign-free: dchi2 %.1f threshold %.3g over %zu edges\n",
+                 fs.dchi2, fs.threshold, jumps.size());
   return m;
 }
 
