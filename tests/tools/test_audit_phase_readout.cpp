@@ -65,7 +65,7 @@ TEST(AuditPhaseReadout, TheSegmentsFrequencyModelHoldsAPhaseMismatchToAFewTenths
   const std::vector<double> r0 = detail::forced_residuals(with, p);
   p[detail::kPhase] = kPhaseDeg * std::numbers::pi / 180.0;
   const std::vector<double> r1 = detail::forced_residuals(with, p);
-  // The datasets' carriers (each its median wave frequency) differ: the
+  // The datasets' carriers (each its median vibration frequency) differ: the
   // frequencies differ by a constant as well, the fit's mean frequency.
   std::vector<double> miss, part;
   for (std::size_t i = 0; i < with.forced.size(); ++i) {
