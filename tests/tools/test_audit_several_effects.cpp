@@ -111,7 +111,8 @@ TEST(AuditSeveralEffectsFirmware, APhaseMismatchOfDegreesIsNoSpring) {
   // THEN the pump's pull is the phase mismatch's, not an electrostatic
   // spring's (before: `ambiguous`, a spring of -5.6e-7 Hz/V^2 and the phase
   // no finding); the Duffing term within 20 % and 2 sigma; the phase found,
-  // low (0.955 +- 0.095 deg: README Known limits), within half its value
+  // low (1.142 +- 0.2 deg; 0.955 +- 0.095 with the readout between the
+  // single end rows: README step 2), within half its value
   STRCMP_EQUAL_TEXT("explained", r.verdict.c_str(), text.c_str());
   CHECK_TEXT(std::none_of(r.findings.begin(), r.findings.end(),
                           [](const auto& f) { return f.effect == Effect::electrostatic_spring; }),

@@ -700,7 +700,9 @@ double Auditor::forced_scatter(const std::vector<double>& fr, int p, double nu_p
     h(r, 0) = f.mean_v2;
     if (p >= 3) h(r, 1) = f.mean_a2, h(r, 2) = f.mean_temp_c - d_.temp_ref_c;
     if (p == 5) {
-      h(r, 3) = (std::cos(4.0 * f.theta1_rad) - std::cos(4.0 * f.theta0_rad)) / (f.t1_s - f.t0_s);
+      h(r, 3) = f.end_change([](double th0, double th1) {
+        return std::cos(4.0 * th1) - std::cos(4.0 * th0);
+      }) / (f.t1_s - f.t0_s);
       h(r, 4) = f.mean_v2 > 0.0 ? (f.dlna_per_s + nu_per_s) * (1.0 - f.mean_v2c4 / f.mean_v2) : 0.0;
     }
     y(r) = fr[i];

@@ -281,11 +281,13 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   ForcedSegment f;
   f.first_row = q0;
   f.last_row = q1;
-  const std::size_t k = 3;
+  const std::size_t k = kEndRows;
   double ts = 0, te = 0, ps = 0, pe = 0, ls = 0, le = 0;
   cplx gs, ge;  // mean (pump_v / a_A) e^{2 i theta} at the start and the end
   for (std::size_t j = 0; j < k; ++j) {
     ts += r.t[q0 + j] / k, ps += r.phase[q0 + j] / k;
+    f.theta_start_rad[j] = r.theta[q0 + j];
+    f.theta_end_rad[j] = r.theta[q1 - j];
     te += r.t[q1 - j] / k, pe += r.phase[q1 - j] / k;
     ls += 0.5 * std::log(std::max(r.a2[q0 + j], 1e-30)) / k;
     le += 0.5 * std::log(std::max(r.a2[q1 - j], 1e-30)) / k;

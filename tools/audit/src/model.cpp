@@ -222,8 +222,10 @@ std::vector<double> forced_residuals(const Dataset& d, const Params& p) {
                     dw, sg);
       w += dw;
     }
-    double dm = measured_phase(p, f.theta1_rad) - measured_phase(p, f.theta0_rad);
-    dm = std::remainder(dm, kPi);
+    // The readout's change between the rows the measured phase averages.
+    const double dm = f.end_change([&p](double th0, double th1) {
+      return std::remainder(measured_phase(p, th1) - measured_phase(p, th0), kPi);
+    });
     w += dm / (f.t1_s - f.t0_s) + pickoff_pump_pull(f, p);
     r.push_back(f.freq_rad_s - w);
   }
@@ -252,8 +254,9 @@ double measured_theta(const Params& p, double theta) {
 
 double true_growth_per_s(const ForcedSegment& f, const Params& p) {
   if (!any_of(p, {kGain, kMis})) return f.dlna_per_s;
-  const double readout =
-      std::log(measured_wave(p, f.theta1_rad).a_A_v / measured_wave(p, f.theta0_rad).a_A_v);
+  const double readout = f.end_change([&p](double th0, double th1) {
+    return std::log(measured_wave(p, th1).a_A_v / measured_wave(p, th0).a_A_v);
+  });
   return f.dlna_per_s - readout / (f.t1_s - f.t0_s);
 }
 

@@ -115,7 +115,7 @@ std::vector<double> balance_residuals(const Dataset& d, const Params& p);
 std::vector<double> balance_left(const Dataset& d, const Params& p);
 // The true vibration's growth a_A'/a_A over excitation segment f (1/s): its
 // measured growth less the change the pickoff map's readout makes between
-// the segment's end angles (a gain g shows a_A (1 + g sin^2 2theta), a
+// the rows its ends average (a gain g shows a_A (1 + g sin^2 2theta), a
 // misalignment b a_A (1 + b sin 4theta)). The pump's efficiency and the
 // pump's pull follow the true vibration; at the measured growth the pump's
 // law read a gain's readout 2 g theta' sin 4theta as its efficiency.
