@@ -212,30 +212,40 @@ int drop_transients(std::vector<EdgeJump>& jumps, std::vector<const Edge*>& used
 }
 
 // Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
-// (the wave phase is defined modulo pi), minus its noise expectation. Fills
-// dchi2 and threshold; returns the mean of w^2 per pickoff.
+// (the wave phase is defined modulo pi), minus its noise expectation, each
+// edge weighted by the inverse of its term's noise variance (~8 v^2, v the
+// edge's noise over V^2). An amplitude loop leaves the pump at a switch-off
+// anywhere in its range, and an edge at a fifth of the pump has 625x the
+// variance: with equal weights those few edges set the statistic's noise
+// (the firmware's telemetry of `audit-bench --seed 2026`, design 2, 31
+// switch-offs at 0.67-2.93 V: a feedthrough of 1.66e-5 V/V at 17 sigma of
+// its fit gave chi^2 39, delta BIC 3.4). Fills dchi2 and threshold; returns
+// the weighted mean of w^2 per pickoff.
 std::array<cplx, 2> sign_free_detection(const std::vector<EdgeJump>& jumps, double ln_neff,
                                         FeedStat& fs) {
-  const auto n = static_cast<double>(jumps.size());
   std::array<cplx, 2> m{};
-  double s4 = 0.0;
+  double weights = 0.0;  // sum of 1 / v^2
   for (const auto& ej : jumps) {
     const cplx u = std::conj(ej.phasor) / ej.pump_v;
     const auto z = cplx2(ej.j);
     const double v = ej.var / (ej.pump_v * ej.pump_v);
+    const double w_edge = 1.0 / (v * v);
     const Eigen::Matrix4d& pr = ej.proj;
     for (int k = 0; k < 2; ++k) {
       const cplx w = z[static_cast<std::size_t>(k)] * u;
       const cplx bias =
           v * cplx(pr(2 * k, 2 * k) - pr(2 * k + 1, 2 * k + 1), 2.0 * pr(2 * k, 2 * k + 1)) *
           std::conj(ej.phasor * ej.phasor);
-      m[static_cast<std::size_t>(k)] += (w * w - bias) / n;
+      m[static_cast<std::size_t>(k)] += w_edge * (w * w - bias);
     }
-    s4 += 4.0 * v * v / n;
+    weights += w_edge;
   }
-  const double var_m = 2.0 * s4 / n;
+  for (auto& mk : m)
+    mk /= weights;
+  const double var_m = 8.0 / weights;
   fs.dchi2 = 2.0 * (std::norm(m[0]) + std::norm(m[1])) / var_m;
-  fs.threshold = std::pow(4.0 * ln_neff * s4 / n, 0.25);
+  // |c| at which the expected delta BIC is zero: 2 |c|^4 / var_m = 4 ln n.
+  fs.threshold = std::pow(2.0 * ln_neff * var_m, 0.25);
   return m;
 }
 
