@@ -212,7 +212,7 @@ int drop_transients(std::vector<EdgeJump>& jumps, std::vector<const Edge*>& used
 }
 
 // Sign-free detection: the mean of w^2 with w = J e^{-i phi} / V per pickoff
-// (the wave phase is defined modulo pi), minus its noise expectation, each
+// (the vibration's phase is defined modulo pi), minus its noise expectation, each
 // edge weighted by the inverse of its term's noise variance (~8 v^2, v the
 // edge's noise over V^2). An amplitude loop leaves the pump at a switch-off
 // anywhere in its range, and an edge at a fifth of the pump has 625x the
