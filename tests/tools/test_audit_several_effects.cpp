@@ -129,3 +129,51 @@ TEST(AuditSeveralEffectsFirmware, APhaseMismatchOfDegreesIsNoSpring) {
   CHECK_TEXT(std::abs(phase->value - pair[0].value) <= 0.5 * pair[0].value, text.c_str());
   CHECK_TEXT(phase->significance >= 5.0, text.c_str());
 }
+
+TEST(AuditSeveralEffectsFirmware, AFeedthroughBesideTwoEffectsOnTheResonatorIsFound) {
+  // GIVEN the benchmark's triple of design 2 of `hrg audit-bench --seed
+  // 2026` (the firmware's own telemetry; the feedthrough's phases drawn by
+  // seed 1): a Duffing term, a thermal damping and a drive feedthrough of
+  // 1.656e-5 V/V, whose switch-offs find the amplitude loop's pump anywhere
+  // in 0.7-2.9 V
+  const Concealed triple[] = {{Effect::duffing_stiffness, -0.0001593},
+                              {Effect::thermal_damping, 0.01329},
+                              {Effect::drive_feedthrough, 1.656e-05}};
+  bench::Scenario s = bench::test::firmware_design(2026, 2);
+  for (const auto& c : triple)
+    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
+  // WHEN it is audited
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "triple");
+  // THEN all three are findings within 20 %: the switch-offs' statistic
+  // weighs each edge by its noise (before: equal weights, the edges at a
+  // low pump set its noise and the feedthrough was no finding)
+  for (const auto& c : triple)
+    check_finding(r, c, text);
+}
+
+TEST(AuditSeveralEffectsFirmware, ASpringBesideAThermalFrequencyAndAMisalignmentIsFound) {
+  // GIVEN the benchmark's triple of design 17 of `hrg audit-bench --seed
+  // 2026` (the firmware's own telemetry): a thermal frequency, an
+  // electrostatic spring and a pickoff misalignment of -0.05 deg
+  const Concealed triple[] = {{Effect::thermal_frequency, -0.0003438},
+                              {Effect::electrostatic_spring, 4.923e-07},
+                              {Effect::pickoff_misalignment, -0.04987}};
+  bench::Scenario s = bench::test::firmware_design(2026, 17);
+  for (const auto& c : triple)
+    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
+  // WHEN it is audited
+  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const std::string text = hrg::audit::to_text(r, "triple");
+  // THEN all three are findings within 20 %, the spring within 2 of its
+  // sigmas: the excitation segments' frequency weights are measured again
+  // against the selected model, whose misalignment turns the segments'
+  // measured phase (before: weights from the baseline's scatter, the
+  // spring 5.921e-7 +- 8.1e-8, 20.3 % high)
+  for (const auto& c : triple)
+    check_finding(r, c, text);
+  const auto spring = std::find_if(r.findings.begin(), r.findings.end(), [](const auto& f) {
+    return f.effect == Effect::electrostatic_spring;
+  });
+  CHECK_TEXT(std::abs(spring->value - triple[1].value) <= 2.0 * spring->sigma, text.c_str());
+}
