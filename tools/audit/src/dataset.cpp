@@ -267,11 +267,10 @@ double pump_jitter(const Rows& r, std::size_t q0, std::size_t q1) {
   return std::sqrt(d2 / static_cast<double>(q1 - q0 - 1) / 6.0) / level;
 }
 
-// Mean wave frequency and mean inputs over the quiet part of an excitation run.
 // Phase (carrier frame), ln a_A and pattern angle of row i with `dv` added to
 // demodulated signal k (cx, sx, cy, sy), each brought next to the row's own.
-std::array<double, 3> row_wave(const Rows& r, const Dataset& d, std::size_t i, std::size_t k,
-                               double dv) {
+std::array<double, 3> row_envelope(const Rows& r, const Dataset& d, std::size_t i, std::size_t k,
+                                   double dv) {
   std::array<double, 4> v{r.cx[i], r.sx[i], r.cy[i], r.sy[i]};
   v[k] += dv;
   const auto w = dsp::wave_variables<double>({v[0], v[1], v[2], v[3]});
@@ -290,7 +289,8 @@ void offset_sensitivity(const Rows& r, const Dataset& d, std::size_t k, ForcedSe
     // Change of (phase, ln a_A, theta) at row i under the offset c.
     auto delta = [&](std::size_t i) {
       const double s = c < 4 ? 1.0 : r.t[i] - t_mid;
-      const auto up = row_wave(r, d, i, c % 4, s * dv), dn = row_wave(r, d, i, c % 4, -s * dv);
+      const auto up = row_envelope(r, d, i, c % 4, s * dv),
+                 dn = row_envelope(r, d, i, c % 4, -s * dv);
       return std::array<double, 3>{(up[0] - dn[0]) / (2.0 * dv), (up[1] - dn[1]) / (2.0 * dv),
                                    (up[2] - dn[2]) / (2.0 * dv)};
     };
@@ -306,6 +306,7 @@ void offset_sensitivity(const Rows& r, const Dataset& d, std::size_t k, ForcedSe
   }
 }
 
+// Mean wave frequency and mean inputs over the quiet part of an excitation run.
 void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d) {
   const auto [q0, best_len] = quiet_stretch(r, run, d);
   if (best_len < 20 || static_cast<double>(best_len) * dt_typ < 0.5) return;
