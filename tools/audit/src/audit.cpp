@@ -89,6 +89,21 @@ int param_of(Effect e) {
 int second_param_of(Effect e) { return e == Effect::gap_harmonics ? kGapQ : -1; }
 int n_params_of(Effect e) { return second_param_of(e) >= 0 ? 2 : 1; }
 
+// Effects seen only on the excitation segments (the gap harmonics: the
+// pump's balance and drift). Those segments are modelled without the
+// firmware's loops, which act on what the pickoffs read: a
+// pickoff phase mismatch of 1 deg leaves a 4 theta pattern in the pump that
+// reads as eps_p -0.0084 (seed 4 of the default scenario), whether or not
+// the free decays leave structure. So beside an effect on the readout (the
+// pickoff map, the drive feedthrough) such an effect is weighed against the
+// whole misfit; beside effects on the resonator alone, which the segments'
+// model holds (a thermal damping acts on the balance through its damping
+// scale), it is weighed where its evidence lies, as every other effect: a
+// gap of |eps| 0.025 at delta BIC 328 beside a thermal damping on 1800 s of
+// the other resonator removed 9 % of the whole misfit (the damping's on the
+// free decays) and all of the balance's and the angle drift's.
+bool seen_only_on_excitation(Effect e) { return e == Effect::gap_harmonics; }
+
 // The mask with the effect's parameters on (or off).
 Mask with_effect(Mask m, Effect e, bool on = true) {
   for (int i : {param_of(e), second_param_of(e)})
@@ -1279,8 +1294,18 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
       if (param_of(e) < 0) continue;
       State without =
           fit_state(with_effect(full.mask, e, false), without_effect(full.fit.p, e), false);
-      const double unique_dbic = delta_bic(without, full, n_params_of(e));
-      chosen[k].unique_dchi = delta_chi2(without, full);
+      // Seen on the excitation segments alone, an effect is counted beside
+      // the slow noise those see: what an offset or a drift of the
+      // demodulated signals explains as well is not its evidence.
+      double slow = 0.0;
+      if (seen_only_on_excitation(e)) {
+        slow = std::max(0.0, slow_offset_chi2(d_, without.res) - slow_offset_chi2(d_, full.res));
+        if (std::getenv("HRG_AUDIT_DEBUG"))
+          std::fprintf(stderr, "drop-one %s: %.1f of its chi^2 an offset explains as well\n",
+                       effect_info(e).id, slow);
+      }
+      chosen[k].unique_dchi = delta_chi2(without, full) - slow;
+      const double unique_dbic = chosen[k].unique_dchi - n_params_of(e) * ln_neff(full);
       chosen[k].removed_chi2 = std::max(0.0, without.fit.chi2 - full.fit.chi2);
       const auto chi_without = group_chi2(without.res), chi_full = group_chi2(full.res);
       for (std::size_t g = 0; g < 4; ++g)
@@ -1306,20 +1331,6 @@ State Auditor::drop_unneeded(State full, std::vector<Chosen>& chosen, AuditResul
   }
 }
 
-// Effects seen only on the excitation segments (the gap harmonics: the
-// pump's balance and drift). Those segments are modelled without the
-// firmware's loops, which act on what the pickoffs read: a
-// pickoff phase mismatch of 1 deg leaves a 4 theta pattern in the pump that
-// reads as eps_p -0.0084 (seed 4 of the default scenario), whether or not
-// the free decays leave structure. So beside an effect on the readout (the
-// pickoff map, the drive feedthrough) such an effect is weighed against the
-// whole misfit; beside effects on the resonator alone, which the segments'
-// model holds (a thermal damping acts on the balance through its damping
-// scale), it is weighed where its evidence lies, as every other effect: a
-// gap of |eps| 0.025 at delta BIC 328 beside a thermal damping on 1800 s of
-// the other resonator removed 9 % of the whole misfit (the damping's on the
-// free decays) and all of the balance's and the angle drift's.
-bool seen_only_on_excitation(Effect e) { return e == Effect::gap_harmonics; }
 bool acts_on_readout(Effect e) {
   return e == Effect::pickoff_gain_mismatch || e == Effect::pickoff_phase_mismatch ||
          e == Effect::pickoff_misalignment || e == Effect::drive_feedthrough;

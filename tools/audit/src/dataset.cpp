@@ -2,6 +2,7 @@
 #include "dataset.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -266,6 +267,45 @@ double pump_jitter(const Rows& r, std::size_t q0, std::size_t q1) {
   return std::sqrt(d2 / static_cast<double>(q1 - q0 - 1) / 6.0) / level;
 }
 
+// Phase (carrier frame), ln a_A and pattern angle of row i with `dv` added to
+// demodulated signal k (cx, sx, cy, sy), each brought next to the row's own.
+std::array<double, 3> row_envelope(const Rows& r, const Dataset& d, std::size_t i, std::size_t k,
+                                   double dv) {
+  std::array<double, 4> v{r.cx[i], r.sx[i], r.cy[i], r.sy[i]};
+  v[k] += dv;
+  const auto w = dsp::wave_variables<double>({v[0], v[1], v[2], v[3]});
+  const double phase = w.phase_rad + d.frame_phase_rad[i];
+  return {r.phase[i] + std::remainder(phase - r.phase[i], kPi), std::log(std::max(w.a_A_v, 1e-15)),
+          r.theta[i] + std::remainder(w.theta_A_rad - r.theta[i], kPi / 2.0)};
+}
+
+// ForcedSegment::per_offset by central differences at the segment's end rows
+// (k of them at each end for the phase and ln a_A, single rows for the angle).
+void offset_sensitivity(const Rows& r, const Dataset& d, std::size_t k, ForcedSegment& f) {
+  const std::size_t q0 = f.first_row, q1 = f.last_row;
+  const double dv = 1e-4 * std::sqrt(std::max(r.a2[q1], 1e-30));
+  const double t_mid = 0.5 * (r.t.front() + r.t.back());
+  for (std::size_t c = 0; c < 8; ++c) {
+    // Change of (phase, ln a_A, theta) at row i under the offset c.
+    auto delta = [&](std::size_t i) {
+      const double s = c < 4 ? 1.0 : r.t[i] - t_mid;
+      const auto up = row_envelope(r, d, i, c % 4, s * dv),
+                 dn = row_envelope(r, d, i, c % 4, -s * dv);
+      return std::array<double, 3>{(up[0] - dn[0]) / (2.0 * dv), (up[1] - dn[1]) / (2.0 * dv),
+                                   (up[2] - dn[2]) / (2.0 * dv)};
+    };
+    double dphase = 0.0, dlna = 0.0;
+    for (std::size_t j = 0; j < k; ++j) {
+      const auto e = delta(q1 - j), b = delta(q0 + j);
+      dphase += (e[0] - b[0]) / static_cast<double>(k);
+      dlna += (e[1] - b[1]) / static_cast<double>(k);
+    }
+    f.per_offset[0][c] = dphase / (f.t1_s - f.t0_s);
+    f.per_offset[1][c] = dlna / (f.t1_s - f.t0_s);
+    f.per_offset[2][c] = (delta(q1)[2] - delta(q0)[2]) / f.angle_span_s;
+  }
+}
+
 // Mean wave frequency and mean inputs over the quiet part of an excitation run.
 void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d) {
   const auto [q0, best_len] = quiet_stretch(r, run, d);
@@ -340,6 +380,7 @@ void add_forced_segment(const Rows& r, const Run& run, double dt_typ, Dataset& d
   // theta from single rows: half the phase's noise per row (theta = arg / 2).
   const double inv_a2_end_rows = 1.0 / std::max(r.a2[q0], 1e-30) + 1.0 / std::max(r.a2[q1], 1e-30);
   f.angle_se_rad_s = std::sqrt(noise2 * inv_a2_end_rows) / 2.0 / f.angle_span_s;
+  offset_sensitivity(r, d, k, f);
   d.forced.push_back(f);
 }
 

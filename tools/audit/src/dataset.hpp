@@ -106,6 +106,13 @@ struct ForcedSegment {
   // true one, and a pump off the wave pulls the true frequency in proportion
   // to its drive (pump_phase_pull, model.hpp).
   double ft_hx_v2 = 0.0, ft_hy_v2 = 0.0;
+  // Slow noise on the demodulated signals as the segment's observations see
+  // it: the change of freq_rad_s, dlna_per_s and the pattern-angle drift
+  // (rows 0-2) per volt of an offset on cx, sx, cy, sy (columns 0-3) and per
+  // volt of one growing in time, 1 V per second from the recording's middle
+  // (columns 4-7). The slowest octaves of 1/f noise are such offsets and
+  // drifts, read at the end rows (offset_shapes, noise_model.hpp).
+  std::array<std::array<double, 8>, 3> per_offset{};
 };
 
 // A switching of exc between a free-decay segment and an excitation segment.

@@ -250,4 +250,43 @@ double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArN
   return chi2;
 }
 
+double slow_offset_chi2(const Dataset& d, const std::vector<double>& res) {
+  std::size_t n_free = 0;
+  for (const auto& seg : d.free)
+    n_free += 4 * seg.n_blocks;
+  const auto groups = forced_groups(d, n_free, res.size());
+  if (groups.empty()) return 0.0;
+  constexpr int kShapes = 8;
+  Eigen::Matrix<double, kShapes, kShapes> n = Eigen::Matrix<double, kShapes, kShapes>::Zero();
+  Eigen::Matrix<double, kShapes, 1> g = Eigen::Matrix<double, kShapes, 1>::Zero();
+  // Group g's observations are the segments with a weight there, in order.
+  auto weight = [](const ForcedSegment& f, std::size_t group) {
+    return group == 0 ? f.sigma_rad_s : group == 1 ? f.balance_sigma_per_s : f.angle_sigma_rad_s;
+  };
+  for (std::size_t grp = 0; grp < 3; ++grp) {
+    std::size_t i = groups[grp].first;
+    for (const auto& f : d.forced) {
+      const double w = weight(f, grp);
+      if (!(w > 0.0) || i >= groups[grp].second) continue;
+      Eigen::Matrix<double, kShapes, 1> j;
+      for (int c = 0; c < kShapes; ++c)
+        j(c) = f.per_offset[grp][static_cast<std::size_t>(c)] / w;
+      n.noalias() += j * j.transpose();
+      g += j * res[i++];
+    }
+  }
+  if (!(n.trace() > 0.0)) return 0.0;
+  // Shapes a recording cannot tell apart (a pickoff the pattern never
+  // reaches) are dropped by the pseudo-inverse rather than fitted twice.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kShapes, kShapes>> es(n);
+  const auto& ev = es.eigenvalues();
+  double chi2 = 0.0;
+  for (int k = 0; k < kShapes; ++k) {
+    if (!(ev(k) > 1e-9 * ev(kShapes - 1))) continue;
+    const double p = es.eigenvectors().col(k).dot(g);
+    chi2 += p * p / ev(k);
+  }
+  return chi2;
+}
+
 }  // namespace hrg::audit::detail

@@ -63,4 +63,14 @@ ArNoise fit_ar_noise(const Dataset& d, const std::vector<double>& res);
 // their weights' level, at slow shapes).
 double whitened_chi2(const Dataset& d, const std::vector<double>& res, const ArNoise& ar);
 
+// chi^2 of the excitation segments' observations in `res` (the model's
+// residual vector, free decays first) that slow noise on the demodulated
+// signals explains: an offset on each of cx, sx, cy, sy and one drifting
+// linearly in time (the slowest octaves of 1/f noise over a recording), seen
+// through each segment's end rows (ForcedSegment::per_offset, over each
+// observation's weight), fitted by least squares. Such an offset beats with
+// the vibration's phase turning in the demodulation frame and with the pattern
+// angle, and the segments' cadence aliases it to slow patterns of the angle.
+double slow_offset_chi2(const Dataset& d, const std::vector<double>& res);
+
 }  // namespace hrg::audit::detail
