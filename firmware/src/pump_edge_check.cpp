@@ -35,6 +35,7 @@ void PumpEdgeCheck::reset() {
   was_on_ = false;
   in_edge_ = false;
   weight_ = 0.0;
+  max_pump_v_ = 0.0;
   weighted_r_ = {};
   weighted_rr_ = {};
   since_set_ = false;
@@ -153,6 +154,7 @@ void PumpEdgeCheck::finish_edge() {
     weighted_r_[c] += w * r[c];
     weighted_rr_[c] += w * r[c] * r[c];
   }
+  max_pump_v_ = std::max(max_pump_v_, std::sqrt(p2));
   ++status_.edges;
   decide();
 }
@@ -179,7 +181,10 @@ void PumpEdgeCheck::decide() {
   s.y_im = weighted_r_[3] / weight_;
   s.sigma_v_per_v = 1.0 / std::sqrt(weight_);
   s.scatter_v_per_v = scatter();
-  const double v0 = std::sqrt(pump_re_v_ * pump_re_v_ + pump_im_v_ * pump_im_v_);
+  // The step acts at whatever pump the loop applies: judged at the largest
+  // seen, not at the last edge's (an edge where the AGC's pump was near zero
+  // would scale a whole feedthrough down to nothing).
+  const double v0 = max_pump_v_;
   s.step_v = std::max(std::hypot(s.x_re, s.x_im), std::hypot(s.y_re, s.y_im)) * v0;
   s.step_sigma_v = s.sigma_v_per_v * v0;
   s.tolerance_v = 2.0 * amplitude_v_ * std::sin(cfg_.max_readout_step_rad);

@@ -57,6 +57,8 @@ struct EdgeFeed {
   uint32_t nco_base = 0;
   // The pump's amplitude swinging row to row by this fraction (the AGC's chatter).
   double pump_swing = 0.0;
+  // The pump's level against kPumpV (the AGC's pump beating between its limits).
+  double pump_scale = 1.0;
   // Row time: advances by row_s per row over every run.
   double t_s = 0.0;
   double row_s = 0.01;
@@ -73,7 +75,8 @@ struct EdgeFeed {
       const cplx slope_y = on ? cplx{1e-6, 0.0} : cplx{-2e-6, -4e-6};
       cplx x = x_e + slope_x * (t - t_e);
       cplx y = y_e + slope_y * (t - t_e);
-      const double v0 = kPumpV * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      const double v0 =
+          pump_scale * kPumpV * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
       const cplx p = std::polar(v0, kPumpPhaseRad);
       if (on) {
         x += r_x * p;
@@ -199,6 +202,29 @@ TEST(PumpEdgeCheck, EdgesAverageAndAResetForgetsThem) {
   // THEN only that edge counts
   LONGS_EQUAL(1, c.status().edges);
   DOUBLES_EQUAL(1e-3, c.status().x_re, 4.0 * sigma);
+  CHECK(c.status().verdict == PumpEdgeVerdict::step);
+}
+
+TEST(PumpEdgeCheck, AnEdgeAtANearZeroPumpDoesNotScaleAFeedthroughReadAtTheOthersDown) {
+  // GIVEN r_x = 2e-4 V/V (a step of 6e-4 V at 3 V of pump, 3.4x the
+  // tolerance), three edges at 3 V and then one at 0.01 V (the AGC's pump
+  // near its lower limit): that edge reads r 300x noisier
+  EdgeFeed feed;
+  feed.r_x = {2e-4, 0.0};
+  PumpEdgeCheck c(feed.cfg);
+  for (int i = 0; i < 3; ++i)
+    feed.run(c, 200, 100);
+  feed.pump_scale = 0.01 / kPumpV;
+  feed.run(c, 200, 100);
+  LONGS_EQUAL(4, c.status().edges);
+  // THEN the mean keeps the 3 V edges' r (each weighted by its noise: the
+  // last one's weight is 1e-5 of theirs) and their sigma, 1/sqrt(3) of one
+  const double sigma = sigma_r_one_edge(feed.cfg);
+  DOUBLES_EQUAL(sigma / std::sqrt(3.0), c.status().sigma_v_per_v, 0.05 * sigma);
+  DOUBLES_EQUAL(2e-4, c.status().x_re, 4.0 * sigma);
+  // AND the step is judged at the largest pump seen, 3 V, not at the last
+  // edge's 0.01 V (where it would be 2e-6 V, "consistent"): a step
+  DOUBLES_EQUAL(2e-4 * kPumpV, c.status().step_v, 4.0 * sigma * kPumpV);
   CHECK(c.status().verdict == PumpEdgeVerdict::step);
 }
 

@@ -21,9 +21,12 @@
 // The step this leaves while the pump runs, |r| V0 (the larger channel),
 // turns the pattern angle read at amplitude a by up to |r| V0 / (2 a): it is
 // tolerated up to max_readout_step_rad of readout (tolerance_v = 2 a sin of
-// it). Verdict: `step` when the step exceeds the tolerance by n_sigma of its
-// noise, `consistent` when it stays under it by n_sigma, else `unknown`.
-// No heap; a fixed amount of work per row (the fits once per edge).
+// it). V0 is the largest pump envelope of the edges seen: the AGC's pump
+// moves between its limits, and a feedthrough read at an edge near zero pump
+// acts in full at the largest. Verdict: `step` when the step exceeds the
+// tolerance by n_sigma of its noise, `consistent` when it stays under it by
+// n_sigma, else `unknown`. No heap; a fixed amount of work per row (the fits
+// once per edge).
 
 #include <array>
 #include <cstdint>
@@ -76,7 +79,8 @@ struct PumpEdgeStatus {
   // How long the correction the edges were read through has been in force:
   // from the first row after the last reset to the last row (s).
   double in_force_s = 0.0;
-  // At the last edge's pump and amplitude: the step, its sigma, the tolerance (V).
+  // At the largest pump of the edges and the last edge's amplitude: the
+  // step, its sigma, the tolerance (V).
   double step_v = 0.0;
   double step_sigma_v = 0.0;
   double tolerance_v = 0.0;
@@ -145,6 +149,8 @@ class PumpEdgeCheck {
   double pump_re_v_ = 0.0;
   double pump_im_v_ = 0.0;
   double amplitude_v_ = 0.0;
+  // The largest pump envelope of the edges since the last reset (V).
+  double max_pump_v_ = 0.0;
   // Inverse-variance sums of r and r^2 over the edges.
   double weight_ = 0.0;
   std::array<double, 4> weighted_r_{};
