@@ -387,6 +387,19 @@ struct Both {
     return b.add_sample(s) && ok_a;
   }
 };
+
+// The estimator's control samples with white noise on the measured
+// amplitude (the batch fits scatter as on a real pickoff).
+struct NoisyAmplitude {
+  Estimator& e;
+  std::mt19937_64& rng;
+  std::normal_distribution<double>& n;
+  void restart() { e.restart_control(); }
+  bool add_sample(PumpDriftEstimator::Sample s) {
+    s.a_A_v += n(rng);
+    return e.add_control_sample(s);
+  }
+};
 }  // namespace
 
 TEST(ControlDrift, PumpFitIntegratesThePumpThatActedOnTheRow) {
@@ -463,17 +476,7 @@ TEST(ControlDrift, ALostPumpDriftIsReported) {
   ring.p = est.model();
   ring.t = 200.0;
   std::normal_distribution<double> noise(0.0, 1e-6);
-  struct Noisy {
-    Estimator& e;
-    std::mt19937_64& rng;
-    std::normal_distribution<double>& n;
-    void restart() { e.restart_control(); }
-    bool add_sample(PumpDriftEstimator::Sample s) {
-      s.a_A_v += n(rng);
-      return e.add_control_sample(s);
-    }
-  };
-  Noisy sink{est, rng, noise};
+  NoisyAmplitude sink{est, rng, noise};
   CHECK(ring.run(400.0, sink));
   // THEN its D_Phi is in force and nothing is lost
   CHECK(est.pump_drift().usable());
@@ -510,17 +513,7 @@ struct KnownGapTrial {
     ring.p = est.model();
     ring.t = 200.0;
     std::normal_distribution<double> noise(0.0, 1e-6);
-    struct Noisy {
-      Estimator& e;
-      std::mt19937_64& rng;
-      std::normal_distribution<double>& n;
-      void restart() { e.restart_control(); }
-      bool add_sample(PumpDriftEstimator::Sample s) {
-        s.a_A_v += n(rng);
-        return e.add_control_sample(s);
-      }
-    };
-    CHECK(ring.run(duration_s, Noisy{est, rng, noise}));
+    CHECK(ring.run(duration_s, NoisyAmplitude{est, rng, noise}));
   }
   // The fit's eps_p and its sigma.
   void fit_eps_p(double& eps_p, double& sigma) const {
