@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "audit/audit.hpp"
@@ -43,6 +44,14 @@ void check_finding(const AuditResult& r, const Concealed& c, const std::string& 
   CHECK_TEXT(it->significance >= 5.0, text.c_str());
 }
 
+// The audit of scenario s with each of `effects` concealed in it (their
+// phases drawn by seed 1).
+AuditResult audit_with(bench::Scenario s, std::span<const Concealed> effects) {
+  for (const auto& c : effects)
+    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
+  return hrg::audit::run_audit(bench::simulate(s));
+}
+
 }  // namespace
 
 TEST_GROUP(AuditSeveralEffects){};
@@ -54,11 +63,8 @@ TEST(AuditSeveralEffects, ATripleOnTelemetryIsFoundWhole) {
   const Concealed triple[] = {{Effect::thermal_damping, 0.003284},
                               {Effect::thermal_frequency, -0.0003257},
                               {Effect::electrostatic_spring, 2.821e-08}};
-  bench::Scenario s = telemetry();
-  for (const auto& c : triple)
-    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
   // WHEN it is audited
-  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const AuditResult r = audit_with(telemetry(), triple);
   const std::string text = hrg::audit::to_text(r, "triple");
   // THEN all three are findings within 20 % (before: the thermal damping,
   // 2.919e-3 at 7.1 sigma, an alternative that removed 3.5 % of a misfit
@@ -77,11 +83,8 @@ TEST(AuditSeveralEffects, ASpringBesideAPhaseMismatchAndAFeedthroughIsFound) {
   const Concealed triple[] = {{Effect::pickoff_phase_mismatch, -0.002195},
                               {Effect::electrostatic_spring, -1.616e-08},
                               {Effect::drive_feedthrough, 1.027e-05}};
-  bench::Scenario s = bench::test::telemetry_design(2026, 7, 360.0);
-  for (const auto& c : triple)
-    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
   // WHEN it is audited
-  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const AuditResult r = audit_with(bench::test::telemetry_design(2026, 7, 360.0), triple);
   const std::string text = hrg::audit::to_text(r, "triple");
   // THEN all three are findings within 20 %: in the feedthrough's pull test
   // the phase mismatch's shapes on the excitation segments' frequency are
@@ -102,11 +105,8 @@ TEST(AuditSeveralEffectsFirmware, APhaseMismatchOfDegreesIsNoSpring) {
   // the firmware's pump follows, beside a Duffing term
   const Concealed pair[] = {{Effect::pickoff_phase_mismatch, 1.513},
                             {Effect::duffing_stiffness, 0.0002434}};
-  bench::Scenario s = bench::test::firmware_design(2026, 5);
-  for (const auto& c : pair)
-    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
   // WHEN it is audited
-  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const AuditResult r = audit_with(bench::test::firmware_design(2026, 5), pair);
   const std::string text = hrg::audit::to_text(r, "pair");
   // THEN the pump's pull is the phase mismatch's, not an electrostatic
   // spring's (before: `ambiguous`, a spring of -5.6e-7 Hz/V^2 and the phase
@@ -139,11 +139,8 @@ TEST(AuditSeveralEffectsFirmware, AFeedthroughBesideTwoEffectsOnTheResonatorIsFo
   const Concealed triple[] = {{Effect::duffing_stiffness, -0.0001593},
                               {Effect::thermal_damping, 0.01329},
                               {Effect::drive_feedthrough, 1.656e-05}};
-  bench::Scenario s = bench::test::firmware_design(2026, 2);
-  for (const auto& c : triple)
-    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
   // WHEN it is audited
-  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const AuditResult r = audit_with(bench::test::firmware_design(2026, 2), triple);
   const std::string text = hrg::audit::to_text(r, "triple");
   // THEN all three are findings within 20 %: the switch-offs' statistic
   // weighs each edge by its noise (before: equal weights, the edges at a
@@ -159,11 +156,8 @@ TEST(AuditSeveralEffectsFirmware, ASpringBesideAThermalFrequencyAndAMisalignment
   const Concealed triple[] = {{Effect::thermal_frequency, -0.0003438},
                               {Effect::electrostatic_spring, 4.923e-07},
                               {Effect::pickoff_misalignment, -0.04987}};
-  bench::Scenario s = bench::test::firmware_design(2026, 17);
-  for (const auto& c : triple)
-    CHECK(bench::conceal_by_id(s, hrg::audit::effect_info(c.effect).id, c.value, 1));
   // WHEN it is audited
-  const AuditResult r = hrg::audit::run_audit(bench::simulate(s));
+  const AuditResult r = audit_with(bench::test::firmware_design(2026, 17), triple);
   const std::string text = hrg::audit::to_text(r, "triple");
   // THEN all three are findings within 20 %, the spring within 2 of its
   // sigmas: the excitation segments' frequency weights are measured again
