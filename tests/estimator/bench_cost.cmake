@@ -16,6 +16,7 @@ count(output hrg_bench_est_output 10000 10000 "DriftCompensator::step (1 kHz dri
 count(selfcal_sample hrg_bench_selfcal_sample 4 12000 "pickoff self-calibration add_sample (1 kHz, in windows)")
 count(selfcal_solve hrg_bench_selfcal_solve 100 100 "pickoff self-calibration solve (5x5, after each window)")
 count(selfcal_checks hrg_bench_selfcal_checks 100 100 "readout checks on each solve (damping disagreement + pattern sigmas)")
+count(selfcal_weigh hrg_bench_selfcal_weigh 100 100 "self-calibration round's weighing (evidence-weighted map + step)")
 count(modelcheck_sample hrg_bench_modelcheck_sample 4 12000 "damping model check add_sample (1 kHz, in windows)")
 count(modelcheck_solve hrg_bench_modelcheck_solve 100 100 "damping model check solve (4x4, after each window)")
 count(pumpdrift_sample hrg_bench_pumpdrift_sample 60000 60000 "pump drift fit add_sample + d_phi (1 kHz, excitation on; folds every 10 s)")

@@ -3,9 +3,11 @@
 // instructions inside each hrg_bench_est_* function and divides by its count).
 //   bench_estimator_cost <op> <count>
 //   op: sample | window | solve | solve_alt | output | selfcal_sample | selfcal_solve |
-//       modelcheck_sample | modelcheck_solve | pumpdrift_sample | knowngap_step
+//       selfcal_checks | selfcal_weigh | modelcheck_sample | modelcheck_solve | pumpdrift_sample |
+//       knowngap_step
 #include <estimator/damping_model_check.hpp>
 #include <estimator/estimator.hpp>
+#include <estimator/pickoff_evidence.hpp>
 #include <estimator/pickoff_self_calibration.hpp>
 
 #include <cmath>
@@ -40,6 +42,7 @@ extern "C" {
 void hrg_bench_selfcal_sample(PickoffSelfCalibration& cal, const WaveSample* s, int n);
 PickoffSelfCalResult hrg_bench_selfcal_solve(const PickoffSelfCalibration& cal);
 double hrg_bench_selfcal_checks(const PickoffSelfCalResult& r, const ParamVector& p);
+double hrg_bench_selfcal_weigh(const PickoffSelfCalResult& r, const PickoffMap& in_force);
 void hrg_bench_modelcheck_sample(DampingModelCheck& c, const WaveSample* s, int n);
 DampingModelCheckResult hrg_bench_modelcheck_solve(const DampingModelCheck& c);
 double hrg_bench_pumpdrift_sample(PumpDriftEstimator& f, const PumpDriftEstimator::Sample* s,
@@ -79,6 +82,12 @@ int run_self_calibration(const char* op, int count) {
     solved.decay_consistent = true;
     for (int r = 0; r < count; ++r)
       sink += hrg_bench_selfcal_checks(solved, seed_params(0.2, 0.5));
+  } else if (std::strcmp(op, "selfcal_weigh") == 0) {
+    PickoffSelfCalResult solved = cal.solve();
+    solved.status = Status::ok;
+    const PickoffMap in_force{0.01, 0.008, 0.017};
+    for (int r = 0; r < count; ++r)
+      sink += hrg_bench_selfcal_weigh(solved, in_force);
   } else if (!sample_op) {
     for (int r = 0; r < count; ++r)
       sink += hrg_bench_selfcal_solve(cal).gain;
@@ -180,6 +189,14 @@ __attribute__((noipa)) double hrg_bench_selfcal_checks(const PickoffSelfCalResul
                                                        const ParamVector& p) {
   return damping_anisotropy_disagreement_sigmas(r, p, 1e-6, 1e-6) + readout_pattern_sigmas(r);
 }
+// A self-calibration round's weighing: the map to put in force (each part of
+// the whole estimate weighted by its evidence) and the step to refer the
+// windows through.
+__attribute__((noipa)) double hrg_bench_selfcal_weigh(const PickoffSelfCalResult& r,
+                                                      const PickoffMap& in_force) {
+  const PickoffMap to = evidence_weighted_map(in_force, r);
+  return step_between(in_force, to, r).gain;
+}
 // The damping model check's per-sample step (beside add_sample while a
 // calibration with a damping part is in force) and its solve.
 __attribute__((noipa)) void hrg_bench_modelcheck_sample(DampingModelCheck& c, const WaveSample* s,
@@ -224,7 +241,8 @@ int main(int argc, char** argv) {
   if (argc != 3) {
     std::fprintf(stderr,
                  "usage: %s sample|window|solve|solve_alt|output|selfcal_sample|selfcal_solve|"
-                 "selfcal_checks|modelcheck_sample|modelcheck_solve|pumpdrift_sample|knowngap_step "
+                 "selfcal_checks|selfcal_weigh|modelcheck_sample|modelcheck_solve|pumpdrift_sample|"
+                 "knowngap_step "
                  "<count>\n",
                  argv[0]);
     return 2;

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "dsp/pickoff_correction.hpp"
+#include "estimator/pickoff_evidence.hpp"
 #include "synthetic_decay.hpp"
 
 #include "support/cpputest.hpp"
@@ -254,6 +255,50 @@ TEST(PickoffSelfCalibration, WindowsReReferredThroughTheAppliedCorrectionAllCoun
   // The quadrature row is first order: its cross terms (phi g, phi b) leave
   // ~1e-3 deg here.
   CHECK_TRUE(std::fabs(phi - truth.phase_rad) < 3.0 * r2.phase_sigma_rad + 0.002 * kDeg);
+}
+
+TEST(PickoffSelfCalibration, APartTheGyroDoesNotHaveIsWeighedByItsEvidence) {
+  // GIVEN a gain mismatch alone, 20 windows
+  const Map truth{0.01, 0.0, 0.0};
+  PickoffSelfCalibration cal;
+  feed_windows(cal, truth, kMixedRates, 0, 20);
+  const PickoffSelfCalResult r1 = cal.solve();
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r1.status));
+  // WHEN the firmware weighs the estimate part by part
+  const PickoffMap target = evidence_weighted_map({}, r1);
+  std::printf(
+      "\n  gain alone, 20 windows: estimate b %.1e +- %.1e deg, phi %.1e +- %.1e deg; "
+      "put in force b %.1e, phi %.1e deg\n",
+      r1.misalignment_rad / kDeg, r1.misalignment_sigma_rad / kDeg, r1.phase_rad / kDeg,
+      r1.phase_sigma_rad / kDeg, target.misalignment_rad / kDeg, target.phase_rad / kDeg);
+  // THEN the gain (~2000 sigma) goes in whole, and the misalignment and the
+  // phase the gyro does not have stand nearer their truth than the estimate.
+  DOUBLES_EQUAL(r1.gain, target.gain, 1e-3 * r1.gain_sigma);
+  CHECK_TRUE(std::fabs(target.misalignment_rad) <= std::fabs(r1.misalignment_rad));
+  CHECK_TRUE(std::fabs(target.phase_rad) <= std::fabs(r1.phase_rad));
+  // AND through the step, the windows read the whole estimate less what is
+  // in force: the misalignment and phase left out are still there (the
+  // misalignment read through sqrt(1 - rho^2) of the gain left, 5e-5 of it).
+  cal.refer_to_applied(step_between({}, target, r1));
+  const PickoffSelfCalResult r0 = cal.solve();
+  DOUBLES_EQUAL(r1.misalignment_rad - target.misalignment_rad, r0.misalignment_rad,
+                1e-3 * r1.misalignment_sigma_rad);
+  DOUBLES_EQUAL(r1.phase_rad - target.phase_rad, r0.phase_rad, 1e-12);
+  DOUBLES_EQUAL((1.0 + r1.gain) / (1.0 + target.gain) - 1.0, r0.gain, 1e-3 * r1.gain_sigma);
+  // AND 20 more windows through the correction: the whole estimate is the
+  // truth, and what goes in force after them no farther from it.
+  hrg::dsp::PickoffCorrection<double> k1;
+  CHECK_TRUE(hrg::dsp::pickoff_correction_of(
+      {target.gain, target.phase_rad, target.misalignment_rad}, k1));
+  feed_windows(cal, truth, kMixedRates, 20, 20, k1);
+  const PickoffSelfCalResult r2 = cal.solve();
+  CHECK_EQUAL(static_cast<int>(Status::ok), static_cast<int>(r2.status));
+  const PickoffMapEstimate e = whole_estimate(target, r2);
+  CHECK_TRUE(std::fabs(e.value.gain - truth.gain) < 3.0 * e.sigma.gain + 2e-6);
+  CHECK_TRUE(std::fabs(e.value.misalignment_rad) < 3.0 * e.sigma.misalignment_rad);
+  const PickoffMap next = evidence_weighted_map(target, r2);
+  CHECK_TRUE(std::fabs(next.misalignment_rad) <= std::fabs(e.value.misalignment_rad));
+  CHECK_TRUE(std::fabs(next.phase_rad) <= std::fabs(e.value.phase_rad));
 }
 
 TEST(PickoffSelfCalibration, ADampingThatChangesBetweenWindowsFailsTheDecayTest) {

@@ -350,25 +350,17 @@ def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration
 
 
 def kept_pickoff_map(online):
-    """The pickoff map a board keeps from an online run: what it put in force
-    and, once a round has been applied, the residual the self-calibration
-    still reads over every window of the run (re-referred through the map in
-    force) composed with it, as the firmware composes a round (gains compose,
-    misalignments and phases add). The rounds stop at 4, or when the
-    information has not doubled, half-way through a 365 s run; the residual
-    over the whole run is the better estimate (misalignment row, seeds 1-8:
-    in force off by up to 2.5 of the last round's sigma; tools/gregory/README.md).
-    Not when its solve failed or the decay test refuses the windows: then
-    the map in force."""
-    f, sc = online["in_force"], online["self_cal"]
-    g = f.get("pickoff_y_gain", 0.0)
-    m = f.get("pickoff_y_misalignment_deg", 0.0)
-    p = f.get("pickoff_y_phase_deg", 0.0)
-    if online["rounds"] > 0 and sc.get("status") == "ok" and sc.get("decay_consistent", False):
-        g = (1.0 + g) * (1.0 + sc["gain"]) - 1.0
-        m += sc["misalignment_deg"]
-        p += sc["phase_deg"]
-    return g, m, p
+    """The pickoff map a board keeps from an online run, as the firmware
+    reports it (report.json compensation.self_calibration.keep_*,
+    fw::app::Firmware::pickoff_map_to_keep): once a round has been applied,
+    what a round would put in force at the end of the run, the whole
+    estimate over every window with each part weighted by its evidence
+    (est::evidence_weighted_map); the map in force when the solve failed or
+    the decay test refuses the windows. The rounds stop at 4, or when the
+    information has not doubled, half-way through a 365 s run; the estimate
+    over the whole run is the better one (tools/gregory/README.md)."""
+    sc = online["self_cal"]
+    return sc["keep_gain"], sc["keep_misalignment_deg"], sc["keep_phase_deg"]
 
 
 def run_row(hrg, base, work, rows, name, duration=None, seed=None, tag=None):

@@ -63,6 +63,10 @@ bool better_by(const est::PickoffSelfCalResult& r, const est::PickoffSelfCalResu
          shrunk(r.phase_sigma_rad, before.phase_sigma_rad);
 }
 
+est::PickoffMap pickoff_map(const Calibration& cal) {
+  return {cal.pickoff_y_gain, cal.pickoff_y_misalignment_rad, cal.pickoff_y_phase_rad};
+}
+
 }  // namespace
 
 bool Firmware::apply_calibration(const Calibration& cal, CalibrationSource source) {
@@ -136,20 +140,35 @@ void Firmware::self_calibrate() {
   const bool apply = significant(r, kSelfCalSignificance) ||
                      (self_cal_.rounds > 0 && better_by(r, self_cal_.applied, 2.0));
   if (!apply) return;
-  // The estimate is the residual map seen through the correction in force:
-  // the gains compose, the misalignments and the phases add.
+  // Each part of the whole estimate (what is in force composed with the
+  // residual) weighted by its evidence: a part within its noise of zero
+  // would only add its noise to the output, and a part an earlier round
+  // applied is judged again with every window since.
+  const est::PickoffMap in_force = pickoff_map(cfg_.calibration);
+  const est::PickoffMap target = est::evidence_weighted_map(in_force, r);
+  if (target == in_force) return;
   Calibration next = cfg_.calibration;
-  next.pickoff_y_gain = (1.0 + next.pickoff_y_gain) * (1.0 + r.gain) - 1.0;
-  next.pickoff_y_misalignment_rad += r.misalignment_rad;
-  next.pickoff_y_phase_rad += r.phase_rad;
+  next.pickoff_y_gain = target.gain;
+  next.pickoff_y_misalignment_rad = target.misalignment_rad;
+  next.pickoff_y_phase_rad = target.phase_rad;
   if (!apply_calibration(next, CalibrationSource::online)) return;
+  const est::PickoffSelfCalResult step = est::step_between(in_force, target, r);
   ++self_cal_.rounds;
-  self_cal_.applied = r;
+  self_cal_.applied = step;
   self_cal_.applied_s = gyro_.status().chain.t_s;
   // The model's windows were taken through the old correction: it starts
   // again; the self-calibration keeps its windows, re-referred.
-  estimator_.restart_after_correction(r);
+  estimator_.restart_after_correction(step);
   gyro_.restart_identification();
+}
+
+est::PickoffMap Firmware::pickoff_map_to_keep() const {
+  const est::PickoffMap in_force = pickoff_map(cfg_.calibration);
+  const est::PickoffSelfCalResult& r = estimator_.pickoff_self_calibration();
+  if (!cfg_.online_pickoff_calibration || r.status != est::Status::ok || !r.decay_consistent)
+    return in_force;
+  if (self_cal_.rounds == 0 && !significant(r, kSelfCalSignificance)) return in_force;
+  return est::evidence_weighted_map(in_force, r);
 }
 
 void Firmware::judge_calibration() {

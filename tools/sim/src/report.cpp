@@ -278,9 +278,14 @@ const char* solve_status(est::Status s) {
 
 // The pickoff self-calibration's last solve (est::PickoffSelfCalibration).
 void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
-                           const fw::app::SelfCalibrationStatus& applied) {
+                           const fw::app::SelfCalibrationStatus& applied,
+                           const est::PickoffMap& keep) {
   w.begin_object("self_calibration");
   w.integer("rounds_applied", applied.rounds);
+  // The map kept for the next power-up (Firmware::pickoff_map_to_keep).
+  w.number("keep_gain", keep.gain);
+  w.number("keep_misalignment_deg", keep.misalignment_rad / kDegRad);
+  w.number("keep_phase_deg", keep.phase_rad / kDegRad);
   w.number("last_applied_s", applied.applied_s);
   w.number("last_applied_gain", applied.applied.gain);
   w.number("last_applied_gain_sigma", applied.applied.gain_sigma);
@@ -493,7 +498,7 @@ std::string report_json(const RunConfig& job, const RunResult& r) {
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
   calibration_json(w, r.calibration, r.final_calibration, r.firmware_estimates);
   pump_edge_json(w, r.pump_edge, r.firmware_estimates);
-  self_calibration_json(w, r.self_calibration, r.self_calibration_applied);
+  self_calibration_json(w, r.self_calibration, r.self_calibration_applied, r.self_calibration_keep);
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);

@@ -496,6 +496,7 @@ RunResult run_simulation(const RunConfig& job, const RunOptions& opt) {
   r.calibration = firmware->calibration_status();
   r.self_calibration = firmware->estimator().pickoff_self_calibration();
   r.self_calibration_applied = firmware->self_calibration();
+  r.self_calibration_keep = firmware->pickoff_map_to_keep();
   r.final_calibration = firmware->calibration();
   r.pump_edge = gyro.status().pump_edge;
   r.firmware_estimates = firmware->estimates();

@@ -210,6 +210,9 @@ struct RunResult {
   // The firmware's pickoff self-calibration at the end (its last solve).
   est::PickoffSelfCalResult self_calibration{};
   fw::app::SelfCalibrationStatus self_calibration_applied{};
+  // The pickoff map the firmware keeps for the next power-up
+  // (fw::app::Firmware::pickoff_map_to_keep).
+  est::PickoffMap self_calibration_keep{};
   fw::Calibration final_calibration{};
   fw::PumpEdgeStatus pump_edge{};  // the switch-off step check at the end
   // What the firmware itself read of a calibration's values, for the next

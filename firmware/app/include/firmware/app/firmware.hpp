@@ -6,15 +6,18 @@
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/estimator_port.hpp"
 #include "firmware/gyro.hpp"
+#include "estimator/pickoff_evidence.hpp"
 #include "hal/board.hpp"
 
 namespace hrg::fw::app {
 
 // What the online pickoff self-calibration has put in force.
 struct SelfCalibrationStatus {
-  uint32_t rounds = 0;                  // estimates applied (each restarts the model)
-  est::PickoffSelfCalResult applied{};  // the last one applied (the residual it removed)
-  double applied_s = 0.0;               // when
+  uint32_t rounds = 0;  // estimates applied (each restarts the model)
+  // The last step applied (est::step_between: what it changed in the map,
+  // with the sigmas of the solve it was weighed on).
+  est::PickoffSelfCalResult applied{};
+  double applied_s = 0.0;  // when
 };
 
 // The firmware assembled on a board: the signal chain over dsp::Chain, the
@@ -62,11 +65,12 @@ class Firmware {
   const Calibration& calibration() const { return cfg_.calibration; }
   const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  // An estimate is applied when its solve is accepted (conditioning, one
-  // decay rate across the windows) and it stands out of its own noise by
-  // this many sigma; later, the residual over every window when it stands out
-  // or its information has doubled since the last one applied; at most
-  // kMaxSelfCalRounds times.
+  // A round is applied when the solve is accepted (conditioning, one decay
+  // rate across the windows) and the estimate stands out of its own noise by
+  // this many sigma; later, when the residual over every window stands out
+  // or its information has doubled since the last round; at most
+  // kMaxSelfCalRounds times. A round puts each part of the whole estimate in
+  // force weighted by its evidence (est::evidence_weighted_map).
   static constexpr double kSelfCalSignificance = 5.0;
   static constexpr uint32_t kMaxSelfCalRounds = 4;
 
@@ -79,6 +83,13 @@ class Firmware {
     if (cfg_.online_pickoff_calibration) self_calibrate();
   }
   const SelfCalibrationStatus& self_calibration() const { return self_cal_; }
+  // The pickoff map a board keeps for the next power-up: what a round would
+  // put in force now (the whole estimate of every window, each part weighted
+  // by its evidence, est::evidence_weighted_map) once a round has been
+  // applied or the estimate stands out; else the map in force (also while
+  // the online self-calibration is off, its solve fails or the decay test
+  // refuses its windows).
+  est::PickoffMap pickoff_map_to_keep() const;
   // The firmware's own readings of what a calibration holds, now: the
   // switch-off step check's residual referred to the raw pickoffs through
   // the calibration in force (its edges were read through it: a change of
