@@ -343,7 +343,6 @@ def run_sim(hrg, scenario, out, calibration=None, self_calibrate=False, duration
     comp_adb = d["compensated"]["adb_dph"] if d["compensated"].get("fitted", True) else math.nan
     return {"raw": d["raw"]["adb_dph"], "comp": comp_adb,
             "passed": rep["passed"], "valid": comp.get("valid", True),
-            "in_force": comp.get("calibration", {}),
             "rounds": comp.get("self_calibration", {}).get("rounds_applied", 0),
             "self_cal": comp.get("self_calibration", {}),
             "readout": readout_error_deg(os.path.join(out, "telemetry.csv"))}
