@@ -150,7 +150,7 @@ struct Dataset {
   double temp_span_c = 0.0, a2_span_v2 = 0.0, rate_span_rad_s = 0.0;
   int samples_per_block = 1;
   // Excitation runs left out because their pump_v jitters from row to row
-  // by more than kMaxPumpJitter of its level (dataset.cpp, pump_jitter).
+  // by more than kMaxPumpJitter of its level (excitation_segments.cpp, pump_jitter).
   std::size_t forced_jittery = 0;
   std::vector<std::string> notes;
 };
