@@ -25,6 +25,15 @@ struct WindowConfig {
   double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
   uint32_t check_period_frames = 0;    // after the campaign, a check window this often (0: none)
+  // The first check of a model newly in force (the campaign's end, a model
+  // or calibration changed: model_changed()) comes this long after it (base
+  // frames; 0: the check period), the check period only between later
+  // checks. A model is checked as soon as it is applied: with a 10 min
+  // period, a campaign's model would otherwise go unchecked (and unreported
+  // as valid) for 10 min. Counted from the last window's start at the
+  // campaign's end (the model is that window's fit), never closer than the
+  // window period.
+  uint32_t first_check_delay_frames = 0;
   // Continued identification in operation: after the campaign, windows also
   // open whenever one more keeps the run's excitation-off share at or below
   // this (0: only the check windows above). The check windows count in it,
@@ -75,6 +84,14 @@ class WindowScheduler {
   WindowDecision step(Mode mode, double theta_rad, double theta_rate_rad_s,
                       const EstimatorHealth& health);
 
+  // The model in force has changed (a calibration applied, a model put back):
+  // its first check is due first_check_delay_frames from now. During the
+  // campaign nothing changes (the campaign's end counts). Task context.
+  void model_changed() {
+    check_pending_ = true;
+    since_change_ = 0;
+  }
+
   // New window length and period (a host command); coverage, duty and the
   // campaign state are kept. Zero length is taken as one frame.
   void set_timing(uint32_t length_frames, uint32_t period_frames) {
@@ -105,6 +122,11 @@ class WindowScheduler {
   uint32_t operation_length() const {
     return cfg_.operation_length_frames != 0 ? cfg_.operation_length_frames : cfg_.length_frames;
   }
+  // The settling delay of a model newly in force (frames).
+  uint32_t first_check_delay() const {
+    return cfg_.first_check_delay_frames != 0 ? cfg_.first_check_delay_frames
+                                              : cfg_.check_period_frames;
+  }
   uint32_t check_length() const {
     return cfg_.check_length_frames != 0 ? cfg_.check_length_frames : operation_length();
   }
@@ -131,7 +153,9 @@ class WindowScheduler {
   uint32_t static_frames_ = 0;   // frames the base has been still, after the campaign
   bool moving_ = false;          // a commanded pattern move is under way
   double move_target_rad_ = 0.0;
-  uint32_t move_frames_ = 0;  // frames of the operation walk under way
+  uint32_t move_frames_ = 0;    // frames of the operation walk under way
+  bool check_pending_ = false;  // the model newly in force has had no check yet
+  uint32_t since_change_ = 0;   // frames since it went in force (see model_changed)
 };
 
 }  // namespace hrg::fw
