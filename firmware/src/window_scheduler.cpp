@@ -135,6 +135,8 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
   ++frames_;
   if (since_start_ < UINT32_MAX) ++since_start_;
   if (since_change_ < UINT32_MAX) ++since_change_;
+  const double n = cfg_.still_rate_average_frames > 1 ? cfg_.still_rate_average_frames : 1.0;
+  still_rate_rad_s_ += (theta_rate_rad_s - still_rate_rad_s_) / n;
   if (in_window_) {
     ++off_frames_;
     if (mode != Mode::free_decay) {
@@ -170,7 +172,7 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
         cfg_.refresh_period_frames != 0 && ++since_done_ >= cfg_.refresh_period_frames;
     if (!refresh) {
       // In operation: check and continued-identification windows.
-      const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
+      const bool is_static = std::fabs(still_rate_rad_s_) < cfg_.static_rate_rad_s;
       static_frames_ = is_static ? static_frames_ + 1 : 0;
       const uint32_t length = mode == Mode::operate ? operation_window_due(is_static) : 0;
       if (length != 0) {

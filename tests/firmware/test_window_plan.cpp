@@ -3,6 +3,7 @@
 // checked, and how often after that.
 #include "firmware/app/firmware_config.hpp"
 
+#include <cmath>
 #include <cstdint>
 
 #include "support/window_loop.hpp"
@@ -26,30 +27,32 @@ struct CheckTimes {
   uint32_t first_length = 0;  // frames the first check stays open
 };
 
+const EstimatorHealth kGood{true, 10.0, 1.0};
+// 0.1 rad/s of pattern angle: 4 theta turns every 16 s.
+constexpr double kTurningRadS = 0.1;
+
+// One frame of a table turning the pattern at kTurningRadS (frame f).
+hrg::fw::WindowDecision turning(WindowLoop& l, uint64_t& f) {
+  return l.frame(kTurningRadS * 1e-3 * static_cast<double>(f++), kTurningRadS, kGood);
+}
+
 CheckTimes check_times(const WindowConfig& w) {
   WindowLoop l(w);
-  const EstimatorHealth good{true, 10.0, 1.0};
-  // 0.1 rad/s of pattern angle: 4 theta turns every 16 s.
-  const double rate_rad_s = 0.1;
   uint64_t f = 0;
-  const auto frame = [&] {
-    return l.frame(rate_rad_s * 1e-3 * static_cast<double>(f++), rate_rad_s, good);
-  };
   while (!l.s.campaign_done())
-    frame();
+    turning(l, f);
   const uint64_t last = l.last_open_frame;
   const uint32_t campaign = l.opened;
   CheckTimes t;
-  uint64_t opened_at = 0;
   while (l.opened == campaign)
-    frame();
-  opened_at = l.s.frames();
+    turning(l, f);
+  const uint64_t opened_at = l.s.frames();
   t.first = l.last_open_frame - last;
-  while (!frame().close) {
+  while (!turning(l, f).close) {
   }
   t.first_length = static_cast<uint32_t>(l.s.frames() - opened_at);
   while (l.opened == campaign + 1)
-    frame();
+    turning(l, f);
   t.second = l.last_open_frame - last;
   return t;
 }
@@ -82,4 +85,32 @@ TEST(WindowPlan, TheStandardPlanKeepsItsTwentySecondChecks) {
   LONGS_EQUAL(20000, t.first);
   LONGS_EQUAL(1000, t.first_length);
   LONGS_EQUAL(40000, t.second);
+}
+
+TEST(WindowPlan, TheLongRunPlanChecksOnceTheBaseIsStillThoughItsRateIsNoisy) {
+  // GIVEN the long-run plan after its campaign and first check, the table
+  // turning
+  const WindowConfig w = default_firmware_config({}, WindowPlan::long_run).gyro.windows;
+  WindowLoop l(w);
+  uint64_t f = 0;
+  while (!l.s.campaign_done())
+    turning(l, f);
+  const uint32_t campaign = l.opened;
+  while (l.opened == campaign || l.mode != hrg::fw::Mode::operate)
+    turning(l, f);
+  // WHEN the table stops, the rate read with a noise of 1.5e-3 rad/s
+  // amplitude (above the 1e-3 limit half of the frames: the output's rate
+  // over 10 ms on the 4.2 kHz resonator's parks, 1.4e-3 rms)
+  const uint64_t stopped = l.s.frames();
+  uint64_t opened_at = 0;
+  for (int n = 0; n < 100000 && opened_at == 0; ++n) {
+    const double noise_rad_s = 1.5e-3 * std::sin(2.0 * static_cast<double>(n));
+    if (l.frame(1.0, noise_rad_s, kGood).open) opened_at = l.s.frames();
+  }
+  // THEN a check opens once the averaged rate has been still for a window
+  // period (10 s), long before the 10 min period: averaging 0.2 s of rate
+  // brings the noise far under the limit (unaveraged, no check in 100 s)
+  CHECK(opened_at > 0);
+  CHECK(opened_at - stopped >= w.period_frames);
+  CHECK(opened_at - stopped <= w.period_frames + 5u * w.still_rate_average_frames);
 }
