@@ -135,8 +135,11 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
   ++frames_;
   if (since_start_ < UINT32_MAX) ++since_start_;
   if (since_change_ < UINT32_MAX) ++since_change_;
-  const double n = cfg_.still_rate_average_frames > 1 ? cfg_.still_rate_average_frames : 1.0;
-  still_rate_rad_s_ += (theta_rate_rad_s - still_rate_rad_s_) / n;
+  if (cfg_.still_rate_average_frames > 1) {
+    still_rate_rad_s_ += (theta_rate_rad_s - still_rate_rad_s_) / cfg_.still_rate_average_frames;
+  } else {
+    still_rate_rad_s_ = theta_rate_rad_s;
+  }
   if (in_window_) {
     ++off_frames_;
     if (mode != Mode::free_decay) {
