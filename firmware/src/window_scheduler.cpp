@@ -116,6 +116,11 @@ uint32_t WindowScheduler::operation_window_due(bool is_static) const {
   // one).
   if (cfg_.check_period_frames != 0) {
     if (since_start_ >= cfg_.check_period_frames) return check_length();
+    // A model newly in force: its first check after the settling delay.
+    if (check_pending_ && since_change_ >= first_check_delay() &&
+        since_start_ >= cfg_.period_frames) {
+      return check_length();
+    }
     if (!static_checked_ && is_static && static_frames_ >= cfg_.period_frames &&
         since_start_ >= cfg_.period_frames) {
       return check_length();
@@ -129,6 +134,12 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
   WindowDecision d;
   ++frames_;
   if (since_start_ < UINT32_MAX) ++since_start_;
+  if (since_change_ < UINT32_MAX) ++since_change_;
+  if (cfg_.still_rate_average_frames > 1) {
+    still_rate_rad_s_ += (theta_rate_rad_s - still_rate_rad_s_) / cfg_.still_rate_average_frames;
+  } else {
+    still_rate_rad_s_ = theta_rate_rad_s;
+  }
   if (in_window_) {
     ++off_frames_;
     if (mode != Mode::free_decay) {
@@ -154,18 +165,24 @@ WindowDecision WindowScheduler::step(Mode mode, double theta_rad, double theta_r
   if (!done_ && (estimator_good || cap_reached)) {
     done_ = true;
     since_done_ = 0;
+    // The model now applied is the last window's fit: its settling delay
+    // counts from that window's start.
+    check_pending_ = true;
+    since_change_ = since_start_;
   }
   if (done_) {
     const bool refresh =
         cfg_.refresh_period_frames != 0 && ++since_done_ >= cfg_.refresh_period_frames;
     if (!refresh) {
       // In operation: check and continued-identification windows.
-      const bool is_static = std::fabs(theta_rate_rad_s) < cfg_.static_rate_rad_s;
+      const bool is_static = std::fabs(still_rate_rad_s_) < cfg_.static_rate_rad_s;
       static_frames_ = is_static ? static_frames_ + 1 : 0;
       const uint32_t length = mode == Mode::operate ? operation_window_due(is_static) : 0;
       if (length != 0) {
         operation_window(theta_rad, is_static, length, d);
         static_checked_ = static_checked_ || (d.open && is_static);
+        // Every window after the campaign is a check of the model in force.
+        check_pending_ = check_pending_ && !d.open;
       } else {
         moving_ = false;  // nothing due (or not operating): no walk under way
         move_frames_ = 0;

@@ -8,6 +8,8 @@
 #include <numbers>
 #include <vector>
 
+#include "support/window_loop.hpp"
+
 #include "support/cpputest.hpp"
 
 using hrg::fw::EstimatorHealth;
@@ -29,22 +31,7 @@ WindowConfig small_config() {
   return c;
 }
 
-// A minimal mode machine for the scheduler: operate <-> free_decay.
-struct Loop {
-  WindowScheduler s;
-  Mode mode = Mode::operate;
-  uint32_t opened = 0;
-  explicit Loop(const WindowConfig& c) : s(c) {}
-  WindowDecision frame(double theta, double rate, const EstimatorHealth& h = {}) {
-    const WindowDecision d = s.step(mode, theta, rate, h);
-    if (d.open) {
-      mode = Mode::free_decay;
-      ++opened;
-    }
-    if (d.close) mode = Mode::operate;
-    return d;
-  }
-};
+using Loop = hrg::test::WindowLoop;
 }  // namespace
 
 TEST_GROUP(WindowScheduler){};
@@ -231,6 +218,40 @@ TEST(WindowScheduler, AfterTheCampaignCheckWindowsRunAtTheirPeriodAndOnceTheBase
     l.frame(1.0, 0.0, good);
   LONGS_EQUAL(before + 1, l.opened);
   CHECK(l.s.campaign_done());
+}
+
+TEST(WindowScheduler, AModelNewlyInForceIsCheckedAfterTheSettlingDelayThenAtThePeriod) {
+  // GIVEN a campaign of a window per bin, checks every 5000 frames, the
+  // first one of a model 100 frames after it
+  WindowConfig c = small_config();
+  c.min_windows_per_bin = 1;
+  c.check_period_frames = 5000;
+  c.first_check_delay_frames = 100;
+  Loop l(c);
+  EstimatorHealth good{true, 50.0, 1.0};
+  int f = 0;
+  for (; !l.s.campaign_done(); ++f)  // turning: the campaign ends on the estimator's word
+    l.frame(0.05 * f, 2.0, good);
+  // THEN the campaign's model is checked 100 frames after its last window began
+  const uint64_t last = l.last_open_frame;
+  const uint32_t campaign = l.opened;
+  while (l.opened == campaign)
+    l.frame(0.05 * f++, 2.0, good);
+  LONGS_EQUAL(100, l.last_open_frame - last);
+  // ... and the next check a whole period after that one
+  const uint64_t first = l.last_open_frame;
+  while (l.opened == campaign + 1)
+    l.frame(0.05 * f++, 2.0, good);
+  LONGS_EQUAL(5000, l.last_open_frame - first);
+  // WHEN the model changes in operation (a calibration put in force)
+  for (int n = 0; n < 1000; ++n)
+    l.frame(0.05 * f++, 2.0, good);
+  l.s.model_changed();
+  const uint64_t changed = l.s.frames();
+  while (l.opened == campaign + 2)
+    l.frame(0.05 * f++, 2.0, good);
+  // THEN its check comes 100 frames later, not at the period
+  LONGS_EQUAL(100, l.last_open_frame - changed);
 }
 
 TEST(WindowScheduler, ContinuedIdentificationKeepsTheRunsExcitationOffShareAtTheDuty) {

@@ -97,6 +97,8 @@ void Firmware::put_in_force(const Calibration& cal, bool electronics_changed) {
   estimator_.set_known_gap({cal.gap_eps_p, cal.gap_eps_q, s.eps_p, s.eps_q});
   // The switch-off steps of a signal corrected otherwise start again.
   if (electronics_changed) gyro_.restart_pump_edge_check();
+  // A model changed in operation is checked soon, not a check period later.
+  gyro_.model_changed();
 }
 
 can::FirmwareEstimates Firmware::estimates() const {

@@ -23,6 +23,12 @@ void apply_window_plan(WindowConfig& w, WindowPlan plan) {
     // In operation a check window at least every 10 min (0.8 %), and
     // continued identification up to 2 % excitation off over the run.
     w.check_period_frames = 600000;
+    w.first_check_delay_frames = kFirstCheckDelayFrames;
+    // ... and one as soon as the base is still for a window period (where a
+    // fit made while turning is most likely wrong), the rate averaged over
+    // 0.2 s for it: over the output's 10 ms its noise on a still table
+    // (1.4e-3 rad/s rms on the 4.2 kHz resonator) is above the 1e-3 limit.
+    w.still_rate_average_frames = 200;
     w.operation_duty = kDefaultOperationDuty;
     // Continued identification in 30 s windows (216 times a 5 s window's
     // decay information; 9 % of the amplitude at Q 5e6, 5 kHz; derive()
@@ -45,6 +51,7 @@ void apply_window_plan(WindowConfig& w, WindowPlan plan) {
   // A few-minute run: a check window every 20 s after the campaign (they
   // also feed the identification); the duty rule never opens more.
   w.check_period_frames = 20000;
+  w.first_check_delay_frames = kFirstCheckDelayFrames;
   w.operation_duty = kDefaultOperationDuty;
 }
 

@@ -164,6 +164,11 @@ class Gyro {
   // signals the identifier saw changed: a new pickoff correction). The
   // identifier is restarted by its owner. Call outside a window.
   void restart_identification();
+  // The model in force changed without a new campaign (a calibration put in
+  // force, a part of it taken out): its first check window comes after the
+  // settling delay (WindowConfig::first_check_delay_frames), not a whole
+  // check period later.
+  void model_changed() { scheduler_.model_changed(); }
   // The correction of the pickoffs changed: the switch-off steps seen
   // through the old one are forgotten.
   void restart_pump_edge_check() {

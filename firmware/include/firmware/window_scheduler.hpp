@@ -13,18 +13,33 @@ namespace hrg::fw {
 // the identification; they should be spread evenly over the 4 theta_A circle,
 // since an uneven spread acts like extra weights in the least squares.
 struct WindowConfig {
-  uint32_t length_frames = 100;        // excitation off per window (base frames)
-  uint32_t period_frames = 500;        // minimum spacing between window starts
-  uint32_t max_wait_frames = 5000;     // open anyway after this long (a bin may never be reached)
-  uint32_t bins = 16;                  // 4 theta_A bins over the full circle (<= kMaxBins)
-  uint32_t windows_per_bin = 4;        // cap: the campaign ends when every bin holds this many
-  uint32_t min_windows_per_bin = 0;    // the estimator's word counts once every bin has this many
-  double condition_good = 1.0e4;       // estimator condition number that ends the campaign
-  double coverage_good = 0.9;          // estimator coverage (0..1) that ends the campaign
-  bool rotate_on_static_base = true;   // command the pattern angle to fill empty bins
-  double static_rate_rad_s = 1.0e-3;   // |theta_A'| below this is a static base
+  uint32_t length_frames = 100;       // excitation off per window (base frames)
+  uint32_t period_frames = 500;       // minimum spacing between window starts
+  uint32_t max_wait_frames = 5000;    // open anyway after this long (a bin may never be reached)
+  uint32_t bins = 16;                 // 4 theta_A bins over the full circle (<= kMaxBins)
+  uint32_t windows_per_bin = 4;       // cap: the campaign ends when every bin holds this many
+  uint32_t min_windows_per_bin = 0;   // the estimator's word counts once every bin has this many
+  double condition_good = 1.0e4;      // estimator condition number that ends the campaign
+  double coverage_good = 0.9;         // estimator coverage (0..1) that ends the campaign
+  bool rotate_on_static_base = true;  // command the pattern angle to fill empty bins
+  double static_rate_rad_s = 1.0e-3;  // |theta_A'| below this is a static base
+  // After the campaign the still-base test reads theta_A' averaged
+  // (exponentially) over this many frames (0 or 1: as given). The output's
+  // rate over a few frames is noisier on a still table than
+  // static_rate_rad_s, so unaveraged the base is never still for a window
+  // period and the still-base check never comes.
+  uint32_t still_rate_average_frames = 0;
   uint32_t refresh_period_frames = 0;  // restart the campaign after this long (0: never)
   uint32_t check_period_frames = 0;    // after the campaign, a check window this often (0: none)
+  // The first check of a model newly in force (the campaign's end, a model
+  // or calibration changed: model_changed()) comes this long after it (base
+  // frames; 0: the check period), the check period only between later
+  // checks. A model is checked as soon as it is applied: with a 10 min
+  // period, a campaign's model would otherwise go unchecked (and unreported
+  // as valid) for 10 min. Counted from the last window's start at the
+  // campaign's end (the model is that window's fit), never closer than the
+  // window period.
+  uint32_t first_check_delay_frames = 0;
   // Continued identification in operation: after the campaign, windows also
   // open whenever one more keeps the run's excitation-off share at or below
   // this (0: only the check windows above). The check windows count in it,
@@ -75,6 +90,14 @@ class WindowScheduler {
   WindowDecision step(Mode mode, double theta_rad, double theta_rate_rad_s,
                       const EstimatorHealth& health);
 
+  // The model in force has changed (a calibration applied, a model put back):
+  // its first check is due first_check_delay_frames from now. During the
+  // campaign nothing changes (the campaign's end counts). Task context.
+  void model_changed() {
+    check_pending_ = true;
+    since_change_ = 0;
+  }
+
   // New window length and period (a host command); coverage, duty and the
   // campaign state are kept. Zero length is taken as one frame.
   void set_timing(uint32_t length_frames, uint32_t period_frames) {
@@ -105,6 +128,11 @@ class WindowScheduler {
   uint32_t operation_length() const {
     return cfg_.operation_length_frames != 0 ? cfg_.operation_length_frames : cfg_.length_frames;
   }
+  // The settling delay of a model newly in force (frames).
+  uint32_t first_check_delay() const {
+    return cfg_.first_check_delay_frames != 0 ? cfg_.first_check_delay_frames
+                                              : cfg_.check_period_frames;
+  }
   uint32_t check_length() const {
     return cfg_.check_length_frames != 0 ? cfg_.check_length_frames : operation_length();
   }
@@ -131,7 +159,10 @@ class WindowScheduler {
   uint32_t static_frames_ = 0;   // frames the base has been still, after the campaign
   bool moving_ = false;          // a commanded pattern move is under way
   double move_target_rad_ = 0.0;
-  uint32_t move_frames_ = 0;  // frames of the operation walk under way
+  uint32_t move_frames_ = 0;       // frames of the operation walk under way
+  bool check_pending_ = false;     // the model newly in force has had no check yet
+  double still_rate_rad_s_ = 0.0;  // theta_A' averaged for the still-base test
+  uint32_t since_change_ = 0;      // frames since it went in force (see model_changed)
 };
 
 }  // namespace hrg::fw

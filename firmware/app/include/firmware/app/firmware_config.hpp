@@ -42,6 +42,14 @@ enum class WindowPlan : uint8_t {
   long_run,
 };
 
+// Settling delay of both plans before the first check window of a model
+// newly in force (WindowConfig::first_check_delay_frames; base frames at
+// 1 kHz): 20 s, the standard plan's check period, so that plan's schedule is
+// unchanged; in the long-run plan two window periods (the period lets the
+// amplitude return to its set point after a window) instead of the 10 min
+// between later checks.
+inline constexpr uint32_t kFirstCheckDelayFrames = 20 * kBaseRateHz;
+
 // Excitation-off share that continued identification keeps to in operation
 // (WindowConfig::operation_duty).
 inline constexpr double kDefaultOperationDuty = 0.02;
