@@ -133,10 +133,12 @@ void PumpEdgeCheck::finish_edge() {
   const double p2 = pump_re_v_ * pump_re_v_ + pump_im_v_ * pump_im_v_;
   if (!(p2 > 0.0)) return;
   // Noise per quadrature (both fits pooled, 2 parameters each), and of one
-  // part of r = -dX / P.
+  // part of r = -dX / P: the lines' variance factors count independent
+  // rows, the demodulator's rows are not.
   const double dof = 4.0 * (2.0 * static_cast<double>(cfg_.fit_rows) - 4.0);
   const double var_q = (pre_.rss + post.rss) / dof;
-  const double var_r = var_q * (pre_.var_factor + post.var_factor) / p2;
+  const double var_r =
+      cfg_.row_noise_correlation * var_q * (pre_.var_factor + post.var_factor) / p2;
   if (!(var_r > 0.0)) return;
   // dX = d(cx) - i d(sx); r = -dX conj(P) / |P|^2.
   const auto residual = [&](std::size_t c_i, double& re, double& im) {

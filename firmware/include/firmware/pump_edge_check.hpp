@@ -16,7 +16,7 @@
 // as the line weights its rows at the instant (exact for a pump that varies,
 // as the AGC's does): r = -dX / P per channel, averaged over the edges seen
 // since the correction last changed (weights from the fits' own residual
-// noise).
+// noise, times the rows' correlation).
 //
 // The step this leaves while the pump runs, |r| V0 (the larger channel),
 // turns the pattern angle read at amplitude a by up to |r| V0 / (2 a): it is
@@ -53,6 +53,12 @@ struct PumpEdgeCheckConfig {
   // Readout error a step may cause while the pump runs (rad); 0.005 deg.
   double max_readout_step_rad = 8.726646259971648e-5;
   double n_sigma = 3.0;
+  // The rows' noise is the demodulator's: successive rows share input
+  // samples, so a line through them varies more than through independent
+  // rows by this factor (variance; dsp::decimator_row_noise_correlation,
+  // 2.3233 at the default 100-frame blocks; at 1 an edge's sigma is 1.52x
+  // too small).
+  double row_noise_correlation = 2.3233;
 };
 
 enum class PumpEdgeVerdict : uint8_t {
