@@ -106,6 +106,11 @@ struct EdgeFeed {
   double pump_swing = 0.0;
   // The pump's level against kPumpV (the AGC's pump beating between its limits).
   double pump_scale = 1.0;
+  // The pump held at 0 before this row (relative to the last pump-on row;
+  // the AGC's pump leaving its lower limit), and the wave growing by this
+  // fraction per V^2 and row while it runs (the parametric pump's energy).
+  double pump_rise_row = -1e9;
+  double growth_per_v2_row = 0.0;
   // Row time: advances by row_s per row over every run.
   double t_s = 0.0;
   double row_s = 0.01;
@@ -122,8 +127,18 @@ struct EdgeFeed {
       const cplx slope_y = on ? cplx{1e-6, 0.0} : cplx{-2e-6, -4e-6};
       cplx x = x_e + slope_x * (t - t_e);
       cplx y = y_e + slope_y * (t - t_e);
-      const double v0 =
-          pump_scale * kPumpV * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      const double level = pump_scale * kPumpV;
+      const double v0 = t < pump_rise_row
+                            ? 0.0
+                            : level * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      if (on && growth_per_v2_row != 0.0) {
+        // The integral of V^2 from t_e back to t (the level held from the rise on).
+        const double since_rise = std::max(0.0, t - pump_rise_row);
+        const double bend =
+            growth_per_v2_row * level * level * (since_rise - (t_e - pump_rise_row));
+        x += x_e * bend;
+        y += y_e * bend;
+      }
       const cplx p = std::polar(v0, kPumpPhaseRad);
       if (on) {
         x += r_x * p;
@@ -398,4 +413,46 @@ TEST(PumpEdgeCheck, AnEdgesSigmaIsTheSpreadOfItsReadingUnderTheDemodulatorsNoise
   const double stated = sigma_sum / kEdges;
   DOUBLES_EQUAL(1.0, stated / spread, 0.12);
   DOUBLES_EQUAL(sigma_r_one_edge(feed.cfg), stated, 0.1 * stated);
+}
+
+TEST(PumpEdgeCheck, TheAgcsChatterCarryingAFeedthroughIsNotCountedAsNoise) {
+  // GIVEN one edge of the same noise twice, the pump swinging between 0.3
+  // and 5.7 V from row to row, once with r_x = 2e-4 V/V (2e-4 x 2.7 V of
+  // swing in the rows, 18x the rows' noise) and once with none
+  EdgeFeed with;
+  with.pump_swing = 0.9;
+  with.r_x = {2e-4, 0.0};
+  EdgeFeed without;
+  without.pump_swing = 0.9;
+  PumpEdgeCheck a(with.cfg);
+  PumpEdgeCheck b(without.cfg);
+  with.run(a, 200, 100);
+  without.run(b, 200, 100);
+  // THEN both state the noise's sigma (the feedthrough follows the pump: it
+  // is no misfit; counted as one, the sigma was 4.5x larger)
+  DOUBLES_EQUAL(b.status().sigma_v_per_v, a.status().sigma_v_per_v,
+                0.05 * b.status().sigma_v_per_v);
+  DOUBLES_EQUAL(2e-4, a.status().x_re, 4.0 * a.status().sigma_v_per_v);
+}
+
+TEST(PumpEdgeCheck, APumpLeavingZeroWithinTheRowsBendsTheWaveAndTheStepIsReadThroughTheBend) {
+  // GIVEN r_x = 2e-4 V/V, the pump at 0 until 20 rows before the last
+  // pump-on row and at 3 V from then, the wave growing by 3e-6 per V^2 and
+  // row while it runs (2.7e-5 V per row at 1 V: the parametric pump at its
+  // limit leaving the AGC's lower one)
+  EdgeFeed feed;
+  feed.r_x = {2e-4, 0.0};
+  feed.pump_rise_row = -20.0;
+  feed.growth_per_v2_row = 3e-6;
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN r is read within 3 of its stated sigmas (a line through the bent
+  // rows read x_re 1.38e-4, 4 of its sigmas off though the bend's misfit
+  // had tripled them), y none
+  const PumpEdgeStatus& s = c.status();
+  LONGS_EQUAL(1, s.edges);
+  DOUBLES_EQUAL(2e-4, s.x_re, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.x_im, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.y_re, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.y_im, 3.0 * s.sigma_v_per_v);
 }

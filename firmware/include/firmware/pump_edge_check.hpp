@@ -8,12 +8,13 @@
 // switch-off the corrected quadratures X = cx - i sx, Y = cy - i sy are
 // referred to a fixed frame (the NCO's phase at the last pump-on row's
 // centre, advanced at its frequency then: the PLL's answer to a step does
-// not turn the frame) and fitted with a line on each side (the last pump-on
-// rows; the rows after the demodulator is free of the drive), and both lines
-// are taken to the switch instant. Their difference is -r P, r the residual
+// not turn the frame) and fitted on each side (the last pump-on rows with
+// the bend the pump's own V^2 puts in the wave, fw::PumpOnFit; a line
+// through the rows after the demodulator is free of the drive), and both
+// fits are taken to the switch instant. Their difference is -r P, r the residual
 // feedthrough per volt of pump and P the pump envelope the pump-on rows saw
 // (ChainOutputs::pump_seen_v at the pump's phase against the NCO), weighted
-// as the line weights its rows at the instant (exact for a pump that varies,
+// as the fit weights its rows at the instant (exact for a pump that varies,
 // as the AGC's does): r = -dX / P per channel, averaged over the edges seen
 // since the correction last changed (weights from the fits' own residual
 // noise, times the rows' correlation).
@@ -32,6 +33,7 @@
 #include <cstdint>
 
 #include "firmware/chain_and_identifier.hpp"
+#include "firmware/pump_on_fit.hpp"
 
 namespace hrg::fw {
 
@@ -150,7 +152,7 @@ class PumpEdgeCheck {
   // The edge being measured.
   bool in_edge_ = false;
   uint32_t off_rows_ = 0;  // rows since the last pump-on row
-  LineAt pre_{};
+  PumpOnFit::Result pre_{};
   LineSums post_{};
   double pump_re_v_ = 0.0;
   double pump_im_v_ = 0.0;
