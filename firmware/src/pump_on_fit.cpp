@@ -68,7 +68,7 @@ void PumpOnFit::add(double t, const std::array<double, 4>& q, double p_re, doubl
   }
 }
 
-PumpOnFit::Result PumpOnFit::at(double t_e) const {
+PumpOnFit::Result PumpOnFit::at(double t_e, bool bend) const {
   Result out;
   if (n_ < 3.0) return out;
   const double n = aa_[0], t = aa_[1], q = aa_[2], tt = aa_[3], tq = aa_[4], qq = aa_[5];
@@ -76,7 +76,7 @@ PumpOnFit::Result PumpOnFit::at(double t_e) const {
   const double det2 = n * tt - t * t;
   const double q_about_line = qq - (q * q * tt - 2.0 * q * t * tq + tq * tq * n) / det2;
   const double q_about_mean = qq - q * q / n;
-  const bool with_q = n_ >= 5.0 && q_about_mean > 0.0 && q_about_line > 1e-9 * q_about_mean;
+  const bool with_q = bend && n_ >= 5.0 && q_about_mean > 0.0 && q_about_line > 1e-9 * q_about_mean;
   out.parameters = with_q ? 3 : 2;
   const Mat3 inv = normal_inverse(aa_, with_q);
   // After the last row the pump holds its level until the switch instant.

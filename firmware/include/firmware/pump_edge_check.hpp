@@ -97,6 +97,10 @@ struct PumpEdgeStatus {
 class PumpEdgeCheck {
  public:
   static constexpr uint32_t kMaxFitRows = 64;
+  // The bend's 4 coefficients are kept when they take out of the pump-on
+  // rows' misfit more than F(4, 4 (n - 3)) at 0.1 % (4.7 at n = 64) times the
+  // rows' correlation says chance would.
+  static constexpr double kBendF = 4.7;
 
   explicit PumpEdgeCheck(const PumpEdgeCheckConfig& cfg);
   // The correction of the pickoffs changed: what was seen before is forgotten.
@@ -129,6 +133,13 @@ class PumpEdgeCheck {
   std::array<double, 4> in_frame(const std::array<double, 4>& q, uint32_t centre, double t) const;
   void begin_edge();
   void finish_edge();
+  // r of this edge through one pump-on fit, and that fit's misfit without it.
+  struct Reading {
+    std::array<double, 4> r{};
+    double p2 = 0.0;
+    double pre_rss = 0.0;
+  };
+  static Reading read(const PumpOnFit::Result& pre, const LineAt& post);
   void decide();
   // The mean's sigma from the edges' scatter (PumpEdgeStatus::scatter_v_per_v).
   double scatter() const;
@@ -152,10 +163,11 @@ class PumpEdgeCheck {
   // The edge being measured.
   bool in_edge_ = false;
   uint32_t off_rows_ = 0;  // rows since the last pump-on row
-  PumpOnFit::Result pre_{};
+  // The pump-on side as a line, and with the pump's bend (finish_edge keeps
+  // the bend where it explains the rows better than the line beyond chance).
+  PumpOnFit::Result pre_line_{};
+  PumpOnFit::Result pre_bend_{};
   LineSums post_{};
-  double pump_re_v_ = 0.0;
-  double pump_im_v_ = 0.0;
   double amplitude_v_ = 0.0;
   // The largest pump envelope of the edges since the last reset (V).
   double max_pump_v_ = 0.0;

@@ -43,8 +43,9 @@ class PumpOnFit {
   // One row: t its index (rows, increasing), q its quadratures {cx, sx, cy,
   // sy} and (p_re, p_im) the pump it saw, both in the edge's frame.
   void add(double t, const std::array<double, 4>& q, double p_re, double p_im);
-  // The fit taken to t_e (rows; after the last row the pump holds its last level).
-  Result at(double t_e) const;
+  // The fit taken to t_e (rows; after the last row the pump holds its last
+  // level); `bend` false: a line whatever the pump did.
+  Result at(double t_e, bool bend = true) const;
   // The rows' residual sum of squares once a feedthrough r = {x re, x im,
   // y re, y im} (V/V) has followed the pump about the fit (>= 0).
   static double rss_without_feedthrough(const Result& fit, const std::array<double, 4>& r);
