@@ -107,7 +107,7 @@ struct EdgeFeed {
   // The pump's level against kPumpV (the AGC's pump beating between its limits).
   double pump_scale = 1.0;
   // The pump held at 0 before this row (relative to the last pump-on row;
-  // the AGC's pump leaving its lower limit), and the wave growing by this
+  // the AGC's pump leaving its lower limit), and the vibration growing by this
   // fraction per V^2 and row while it runs (the parametric pump's energy).
   double pump_rise_row = -1e9;
   double growth_per_v2_row = 0.0;
@@ -437,7 +437,7 @@ TEST(PumpEdgeCheck, TheAgcsChatterCarryingAFeedthroughIsNotCountedAsNoise) {
 
 TEST(PumpEdgeCheck, APumpLeavingZeroWithinTheRowsBendsTheWaveAndTheStepIsReadThroughTheBend) {
   // GIVEN r_x = 2e-4 V/V, the pump at 0 until 20 rows before the last
-  // pump-on row and at 3 V from then, the wave growing by 3e-6 per V^2 and
+  // pump-on row and at 3 V from then, the vibration growing by 3e-6 per V^2 and
   // row while it runs (2.7e-5 V per row at 1 V: the parametric pump at its
   // limit leaving the AGC's lower one)
   EdgeFeed feed;

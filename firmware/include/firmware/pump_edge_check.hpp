@@ -9,7 +9,7 @@
 // referred to a fixed frame (the NCO's phase at the last pump-on row's
 // centre, advanced at its frequency then: the PLL's answer to a step does
 // not turn the frame) and fitted on each side (the last pump-on rows with
-// the bend the pump's own V^2 puts in the wave, fw::PumpOnFit; a line
+// the bend the pump's own V^2 puts in the vibration, fw::PumpOnFit; a line
 // through the rows after the demodulator is free of the drive), and both
 // fits are taken to the switch instant. Their difference is -r P, r the residual
 // feedthrough per volt of pump and P the pump envelope the pump-on rows saw

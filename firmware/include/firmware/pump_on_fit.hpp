@@ -3,12 +3,12 @@
 
 // The pump-on side of a switch-off edge (fw::PumpEdgeCheck): the corrected
 // quadratures of the last pump-on rows, fitted to be taken to the switch
-// instant. While the pump runs the wave is not a line when the pump moves:
-// the parametric pump changes the wave at a rate proportional to V^2 (its
+// instant. While the pump runs the vibration is not a line when the pump moves:
+// the parametric pump changes the vibration at a rate proportional to V^2 (its
 // energy and its frequency pull), so a pump that rises from 0 to its limit
-// within the rows bends the wave there. Each quadrature is fitted with
+// within the rows bends the vibration there. Each quadrature is fitted with
 // 1, t and q(t) = the integral of V^2 over the rows (each quadrature its own
-// coefficient: any complex multiple of the wave). Where the pump holds one
+// coefficient: any complex multiple of the envelope). Where the pump holds one
 // level q is a line in t and the fit is the line.
 //
 // The residual feedthrough r P rides on the rows too, and moves with the
