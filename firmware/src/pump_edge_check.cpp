@@ -93,61 +93,75 @@ std::array<double, 4> PumpEdgeCheck::in_frame(const std::array<double, 4>& q, ui
 }
 
 void PumpEdgeCheck::begin_edge() {
-  // The last fit_rows pump-on rows, at t = -(n-1) .. 0 (0: the last one).
-  LineSums pre;
+  // The last fit_rows pump-on rows, at t = -(n-1) .. 0 (0: the last one),
+  // with the pump each saw (fw::PumpOnFit weighs the pump as it weighs them).
+  PumpOnFit pre;
   const uint32_t n = cfg_.fit_rows;
   const uint32_t last = (ring_pos_ + kMaxFitRows - 1) % kMaxFitRows;
   frame_phase_ = ring_phase_[last];
   frame_advance_ = ring_phase_[last] - ring_phase_[(last + kMaxFitRows - 1) % kMaxFitRows];
-  // The pump the rows saw, in the frame, weighted as the line's value at
-  // t_e weights them: w_k = 1/n + d (t_k - mean t) / Sxx, mean t = -(n-1)/2,
-  // Sxx = n (n^2 - 1)/12.
-  const double nd = static_cast<double>(n);
-  const double t_mean = -(nd - 1.0) / 2.0;
-  const double sxx = nd * (nd * nd - 1.0) / 12.0;
-  const double d = cfg_.edge_offset_rows - t_mean;
-  pump_re_v_ = pump_im_v_ = 0.0;
   for (uint32_t k = 0; k < n; ++k) {
     const uint32_t i = (ring_pos_ + kMaxFitRows - n + k) % kMaxFitRows;
     const double t = static_cast<double>(k) - static_cast<double>(n - 1);
-    pre.add(t, in_frame(ring_[i], ring_phase_[i], t));
     // X += r P appears as cx += Re(rP), sx -= Im(rP): P turns as X does.
     const std::array<double, 4> p =
         in_frame({ring_pump_[i][0] * std::cos(ring_pump_[i][1]),
                   -ring_pump_[i][0] * std::sin(ring_pump_[i][1]), 0.0, 0.0},
                  ring_phase_[i], t);
-    const double w = 1.0 / nd + d * (t - t_mean) / sxx;
-    pump_re_v_ += w * p[0];
-    pump_im_v_ -= w * p[1];
+    pre.add(t, in_frame(ring_[i], ring_phase_[i], t), p[0], -p[1]);
   }
-  pre_ = line_at(pre, cfg_.edge_offset_rows);
+  pre_line_ = pre.at(cfg_.edge_offset_rows, false);
+  pre_bend_ = pre.at(cfg_.edge_offset_rows, true);
   amplitude_v_ = last_amplitude_v_;
   post_ = LineSums{};
   off_rows_ = 0;
   in_edge_ = true;
 }
 
+PumpEdgeCheck::Reading PumpEdgeCheck::read(const PumpOnFit::Result& pre, const LineAt& post) {
+  Reading out;
+  const double pr = pre.pump_re_v;
+  const double pi = pre.pump_im_v;
+  out.p2 = pr * pr + pi * pi;
+  if (!(out.p2 > 0.0)) return out;
+  // dX = d(cx) - i d(sx); r = -dX conj(P) / |P|^2.
+  for (std::size_t c = 0; c < 4; c += 2) {
+    const double d_re = post.v[c] - pre.v[c];
+    const double d_im = -(post.v[c + 1] - pre.v[c + 1]);
+    out.r[c] = -(d_re * pr + d_im * pi) / out.p2;
+    out.r[c + 1] = -(d_im * pr - d_re * pi) / out.p2;
+  }
+  // The pump-on rows without r following the pump's own motion: the AGC's
+  // chatter is signal there, not noise.
+  out.pre_rss = PumpOnFit::rss_without_feedthrough(pre, out.r);
+  return out;
+}
+
 void PumpEdgeCheck::finish_edge() {
   in_edge_ = false;
   const LineAt post = line_at(post_, cfg_.edge_offset_rows);
-  const double p2 = pump_re_v_ * pump_re_v_ + pump_im_v_ * pump_im_v_;
+  const double n = static_cast<double>(cfg_.fit_rows);
+  const Reading line = read(pre_line_, post);
+  Reading chosen = line;
+  const PumpOnFit::Result* pre = &pre_line_;
+  if (pre_bend_.parameters == 3) {
+    const Reading bend = read(pre_bend_, post);
+    const double f = (line.pre_rss - bend.pre_rss) / 4.0 / (bend.pre_rss / (4.0 * (n - 3.0)));
+    if (bend.p2 > 0.0 && f > kBendF * cfg_.row_noise_correlation) {
+      chosen = bend;
+      pre = &pre_bend_;
+    }
+  }
+  const double p2 = chosen.p2;
   if (!(p2 > 0.0)) return;
-  // Noise per quadrature (both fits pooled, 2 parameters each), and of one
-  // part of r = -dX / P.
-  const double dof = 4.0 * (2.0 * static_cast<double>(cfg_.fit_rows) - 4.0);
-  const double var_q = (pre_.rss + post.rss) / dof;
-  const double var_r = var_q * (pre_.var_factor + post.var_factor) / p2;
+  const std::array<double, 4>& r = chosen.r;
+  // Noise per quadrature, both fits pooled, and of one part of r: the fits'
+  // variance factors count independent rows, the demodulator's rows are not.
+  const double dof = 4.0 * (2.0 * n - 2.0 - static_cast<double>(pre->parameters));
+  const double var_q = (chosen.pre_rss + post.rss) / dof;
+  const double var_r =
+      cfg_.row_noise_correlation * var_q * (pre->var_factor + post.var_factor) / p2;
   if (!(var_r > 0.0)) return;
-  // dX = d(cx) - i d(sx); r = -dX conj(P) / |P|^2.
-  const auto residual = [&](std::size_t c_i, double& re, double& im) {
-    const double d_re = post.v[c_i] - pre_.v[c_i];
-    const double d_im = -(post.v[c_i + 1] - pre_.v[c_i + 1]);
-    re = -(d_re * pump_re_v_ + d_im * pump_im_v_) / p2;
-    im = -(d_im * pump_re_v_ - d_re * pump_im_v_) / p2;
-  };
-  std::array<double, 4> r{};
-  residual(0, r[0], r[1]);
-  residual(2, r[2], r[3]);
   const double w = 1.0 / var_r;
   weight_ += w;
   for (std::size_t c = 0; c < 4; ++c) {

@@ -171,13 +171,25 @@ void Resonator::expand(double rate_rad_s, double omega_rad_s, double dt_s) {
   expanded_ = true;
 }
 
-double Resonator::pump_delayed(double delay_samples) const {
-  const int whole = static_cast<int>(std::floor(delay_samples));
-  const double frac = delay_samples - whole;
+Resonator::PumpLag Resonator::pump_lag(double delay_samples, double step_rad) {
+  PumpLag lag;
+  lag.whole = static_cast<int>(std::floor(delay_samples));
+  const double frac = delay_samples - lag.whole;
+  // Between two samples of a sinusoid at step_rad per sample, v(t - (k +
+  // f) h) = [sin((1 - f) wh) v_k + sin(f wh) v_k+1] / sin(wh), exact; the
+  // straight line between them is low by up to 1 - cos(wh / 2): 0.16 % at
+  // 4.2 kHz and 100 kHz (5.95 samples), 0 at 5 kHz (5 samples).
+  const double s = std::sin(step_rad);
+  lag.w_whole = std::abs(s) > 1e-9 ? std::sin((1.0 - frac) * step_rad) / s : 1.0 - frac;
+  lag.w_next = std::abs(s) > 1e-9 ? std::sin(frac * step_rad) / s : frac;
+  return lag;
+}
+
+double Resonator::pump_delayed(const PumpLag& lag) const {
   const auto at = [this](int back) {
     return pump_hist_[(hist_pos_ - back + kHistory * 4) % kHistory];
   };
-  return (1.0 - frac) * at(whole) + frac * at(whole + 1);
+  return lag.w_whole * at(lag.whole) + lag.w_next * at(lag.whole + 1);
 }
 
 void Resonator::readd_pump_squares() {
@@ -197,6 +209,8 @@ void Resonator::prepare_step(double rate_rad_s, double w, double dt_s) {
   if (dt_s != dt_last_) {
     dt_last_ = dt_s;
     dc_window_ = pump_dc_window(1.0 / (f_ref_hz_ * dt_s), kHistory - 1);
+    quarter_lag_ = pump_lag(std::min(kHistory - 2.0, 1.0 / (4.0 * f_ref_hz_ * std::abs(dt_s))),
+                            2.0 * kPi * f_ref_hz_ * std::abs(dt_s));
     pump_sum_valid_ = false;
   }
   // The propagator at this rate, Phi + dO Psi1 + dO^2 Psi2, is formed only
@@ -324,10 +338,9 @@ PickoffOutput Resonator::measured_with_effects() const {
     // [t_k - h, t_k)) carries the phase of its middle, half a step before
     // t_k: psi is advanced by w h / 2 (9 deg at 5 kHz and 100 kHz).
     const auto& ft = effects_.drive_feedthrough;
-    const double quarter = std::min(kHistory - 2.0, 1.0 / (4.0 * f_ref_hz_ * std::abs(dt_last_)));
     const double half_step_rad = dt_last_ > 0.0 ? kPi * f_ref_hz_ * dt_last_ : 0.0;
     const double v_now = pump_hist_[hist_pos_];
-    const double v_lag = pump_delayed(quarter);
+    const double v_lag = pump_delayed(quarter_lag_);
     const double px = ft.x_phase_deg * kDegToRad + half_step_rad;
     const double py = ft.y_phase_deg * kDegToRad + half_step_rad;
     x += ft.x_v_per_v * (std::cos(px) * v_now - std::sin(px) * v_lag);

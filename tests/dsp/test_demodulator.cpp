@@ -235,3 +235,37 @@ TEST(Demodulator, RefusesABlockOfTheWrongSize) {
   CHECK_FALSE(d.process_block(frames, phase, 1000, q));
   CHECK_EQUAL(123u, phase);
 }
+
+TEST(Demodulator, TheRowsNoiseCorrelationIsThatOfItsOwnFilter) {
+  // GIVEN the decimator's taps (boxcar_L^N) for L = 1, 4, 100
+  for (uint32_t l : {1u, 4u, 100u}) {
+    std::vector<double> h{1.0};
+    for (uint32_t n = 0; n < kDecimatorOrder; ++n) {
+      std::vector<double> next(h.size() + l - 1, 0.0);
+      for (std::size_t i = 0; i < h.size(); ++i)
+        for (uint32_t j = 0; j < l; ++j)
+          next[i + j] += h[i];
+      h = next;
+    }
+    // WHEN the correlation of outputs m blocks apart, R(mL) / R(0), is
+    // summed over every lag
+    double r0 = 0.0;
+    for (double v : h)
+      r0 += v * v;
+    double sum_rho = 0.0;
+    const auto n_taps = static_cast<long>(h.size());
+    for (long m = -n_taps; m <= n_taps; ++m) {
+      double r = 0.0;
+      for (long i = 0; i < n_taps; ++i) {
+        const long j = i + m * static_cast<long>(l);
+        if (j >= 0 && j < n_taps) r += h[i] * h[j];
+      }
+      sum_rho += r / r0;
+    }
+    // THEN it is the closed form (1 for L = 1: no overlap)
+    DOUBLES_EQUAL(sum_rho, decimator_row_noise_correlation(l), 1e-9 * sum_rho);
+  }
+  // AND at L = 100 it is near its large-L limit 1 / B_10(0) = 362880 / 156190
+  DOUBLES_EQUAL(1.0, decimator_row_noise_correlation(1), 1e-12);
+  DOUBLES_EQUAL(362880.0 / 156190.0, decimator_row_noise_correlation(100), 1e-3);
+}

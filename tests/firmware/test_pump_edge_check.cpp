@@ -6,16 +6,22 @@
 // and says `step` when r V0 is above the readout tolerance 2 a sin(theta_tol).
 #include "firmware/pump_edge_check.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdint>
 #include <random>
+#include <vector>
+
+#include "dsp/demodulator.hpp"
 
 #include "support/cpputest.hpp"
 
 using hrg::fw::ChainRecord;
 using hrg::fw::PumpEdgeCheck;
 using hrg::fw::PumpEdgeCheckConfig;
+using hrg::fw::PumpEdgeStatus;
 using hrg::fw::PumpEdgeVerdict;
 using cplx = std::complex<double>;
 
@@ -26,18 +32,59 @@ constexpr double kPumpV = 3.0;
 constexpr double kPumpPhaseRad = 0.7;
 constexpr double kAmplitudeV = 1.0;
 
-// Gaussian noise from the standardised mt19937_64 (Box-Muller by hand: the
-// same bits on every standard library).
+// The noise of the demodulator's rows: white Gaussian samples (the
+// standardised mt19937_64, Box-Muller by hand: the same bits on every
+// standard library) through its fifth-order decimator, one block of L
+// samples per row, so successive rows share samples as the chain's do;
+// scaled to kNoiseV per row.
 class Noise {
  public:
-  double operator()() {
-    const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
-    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
-    return kNoiseV * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.141592653589793 * u2);
+  static constexpr int kBlock = 100;  // the default chain's block
+  static constexpr int kTaps = static_cast<int>(hrg::dsp::kDecimatorOrder) * (kBlock - 1) + 1;
+
+  Noise() {
+    kernel_.assign(1, 1.0);
+    for (uint32_t n = 0; n < hrg::dsp::kDecimatorOrder; ++n) {
+      std::vector<double> next(kernel_.size() + kBlock - 1, 0.0);
+      for (std::size_t i = 0; i < kernel_.size(); ++i)
+        for (int j = 0; j < kBlock; ++j)
+          next[i + j] += kernel_[i];
+      kernel_ = next;
+    }
+    double sum_sq = 0.0;
+    for (double h : kernel_)
+      sum_sq += h * h;
+    for (double& h : kernel_)
+      h /= std::sqrt(sum_sq);  // unit sd per row
+    for (auto& s : samples_)
+      s.assign(kTaps, 0.0);
+    for (int i = 0; i <= kTaps / kBlock; ++i)
+      row();  // a full window before the first row
+  }
+  // The next row's noise on the 4 quadratures (V).
+  std::array<double, 4> row() {
+    std::array<double, 4> out{};
+    for (std::size_t c = 0; c < 4; ++c) {
+      auto& s = samples_[c];
+      std::rotate(s.begin(), s.begin() + kBlock, s.end());
+      for (int i = kTaps - kBlock; i < kTaps; ++i)
+        s[i] = white();
+      for (int i = 0; i < kTaps; ++i)
+        out[c] += kernel_[i] * s[i];
+      out[c] *= kNoiseV;
+    }
+    return out;
   }
 
  private:
+  double white() {
+    const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
+    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.141592653589793 * u2);
+  }
   std::mt19937_64 rng_{2026};
+  std::vector<double> kernel_;
+  std::array<std::vector<double>, 4> samples_;
 };
 
 // One switch-off edge: `on_rows` rows with the pump on, then `off_rows`
@@ -59,6 +106,11 @@ struct EdgeFeed {
   double pump_swing = 0.0;
   // The pump's level against kPumpV (the AGC's pump beating between its limits).
   double pump_scale = 1.0;
+  // The pump held at 0 before this row (relative to the last pump-on row;
+  // the AGC's pump leaving its lower limit), and the vibration growing by this
+  // fraction per V^2 and row while it runs (the parametric pump's energy).
+  double pump_rise_row = -1e9;
+  double growth_per_v2_row = 0.0;
   // Row time: advances by row_s per row over every run.
   double t_s = 0.0;
   double row_s = 0.01;
@@ -75,8 +127,18 @@ struct EdgeFeed {
       const cplx slope_y = on ? cplx{1e-6, 0.0} : cplx{-2e-6, -4e-6};
       cplx x = x_e + slope_x * (t - t_e);
       cplx y = y_e + slope_y * (t - t_e);
-      const double v0 =
-          pump_scale * kPumpV * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      const double level = pump_scale * kPumpV;
+      const double v0 = t < pump_rise_row
+                            ? 0.0
+                            : level * (1.0 + pump_swing * std::sin(0.7 * static_cast<double>(k)));
+      if (on && growth_per_v2_row != 0.0) {
+        // The integral of V^2 from t_e back to t (the level held from the rise on).
+        const double since_rise = std::max(0.0, t - pump_rise_row);
+        const double bend =
+            growth_per_v2_row * level * level * (since_rise - (t_e - pump_rise_row));
+        x += x_e * bend;
+        y += y_e * bend;
+      }
       const cplx p = std::polar(v0, kPumpPhaseRad);
       if (on) {
         x += r_x * p;
@@ -97,8 +159,8 @@ struct EdgeFeed {
       row.nco_phase = nco_base + static_cast<uint32_t>(k) * nco_advance +
                       static_cast<uint32_t>(static_cast<int32_t>(
                           std::lround(end_rad / 6.283185307179586 * 4294967296.0)));
-      row.quad_v = {x.real() + noise(), -x.imag() + noise(), y.real() + noise(),
-                    -y.imag() + noise()};
+      const std::array<double, 4> n = noise.row();
+      row.quad_v = {x.real() + n[0], -x.imag() + n[1], y.real() + n[2], -y.imag() + n[3]};
       row.pump_v = on ? v0 : 0.0;
       row.pump_seen_v = on ? v0 : 0.0;
       row.pump_phase_rad = kPumpPhaseRad;
@@ -111,7 +173,9 @@ struct EdgeFeed {
 };
 
 // Noise of one part of r from one edge: both lines' extrapolation to t_e,
-// var = sigma^2 (1/N + (t_e - mean t)^2 / Sxx), Sxx = N (N^2 - 1) / 12.
+// var = sigma^2 (1/N + (t_e - mean t)^2 / Sxx), Sxx = N (N^2 - 1) / 12, for
+// independent rows; the decimator's rows vary kappa = 2.3233 times more
+// (dsp::decimator_row_noise_correlation).
 double sigma_r_one_edge(const PumpEdgeCheckConfig& cfg) {
   const double n = cfg.fit_rows;
   const double sxx = n * (n * n - 1.0) / 12.0;
@@ -120,7 +184,7 @@ double sigma_r_one_edge(const PumpEdgeCheckConfig& cfg) {
   const double d_pre = cfg.edge_offset_rows - pre_mean;
   const double d_post = cfg.edge_offset_rows - post_mean;
   const double f = 2.0 / n + (d_pre * d_pre + d_post * d_post) / sxx;
-  return kNoiseV * std::sqrt(f) / kPumpV;
+  return kNoiseV * std::sqrt(f * hrg::dsp::decimator_row_noise_correlation(Noise::kBlock)) / kPumpV;
 }
 
 double tolerance_v(const PumpEdgeCheckConfig& cfg) {
@@ -326,4 +390,69 @@ TEST(PumpEdgeCheck, ItSaysHowLongTheCorrectionItReadThroughHasBeenInForce) {
   feed.run(c, 200, 100);
   // THEN from the first row after the change
   DOUBLES_EQUAL(299 * feed.row_s, c.status().in_force_s, 1e-9);
+}
+
+TEST(PumpEdgeCheck, AnEdgesSigmaIsTheSpreadOfItsReadingUnderTheDemodulatorsNoise) {
+  // GIVEN 100 single edges of noise alone, the rows' noise the decimator's
+  // (successive rows share input samples)
+  EdgeFeed feed;
+  double sum_sq = 0.0;
+  double sigma_sum = 0.0;
+  constexpr int kEdges = 100;
+  for (int i = 0; i < kEdges; ++i) {
+    PumpEdgeCheck c(feed.cfg);
+    feed.run(c, 200, 100);
+    LONGS_EQUAL(1, c.status().edges);
+    const PumpEdgeStatus& s = c.status();
+    sum_sq += s.x_re * s.x_re + s.x_im * s.x_im + s.y_re * s.y_re + s.y_im * s.y_im;
+    sigma_sum += s.sigma_v_per_v;
+  }
+  // THEN the stated sigma is the readings' spread (400 parts: +-3.5 % of
+  // sd); read as from independent rows it was 1 / sqrt(2.3233) = 0.66 of it
+  const double spread = std::sqrt(sum_sq / (4.0 * kEdges));
+  const double stated = sigma_sum / kEdges;
+  DOUBLES_EQUAL(1.0, stated / spread, 0.12);
+  DOUBLES_EQUAL(sigma_r_one_edge(feed.cfg), stated, 0.1 * stated);
+}
+
+TEST(PumpEdgeCheck, TheAgcsChatterCarryingAFeedthroughIsNotCountedAsNoise) {
+  // GIVEN one edge of the same noise twice, the pump swinging between 0.3
+  // and 5.7 V from row to row, once with r_x = 2e-4 V/V (2e-4 x 2.7 V of
+  // swing in the rows, 18x the rows' noise) and once with none
+  EdgeFeed with;
+  with.pump_swing = 0.9;
+  with.r_x = {2e-4, 0.0};
+  EdgeFeed without;
+  without.pump_swing = 0.9;
+  PumpEdgeCheck a(with.cfg);
+  PumpEdgeCheck b(without.cfg);
+  with.run(a, 200, 100);
+  without.run(b, 200, 100);
+  // THEN both state the noise's sigma (the feedthrough follows the pump: it
+  // is no misfit; counted as one, the sigma was 4.5x larger)
+  DOUBLES_EQUAL(b.status().sigma_v_per_v, a.status().sigma_v_per_v,
+                0.05 * b.status().sigma_v_per_v);
+  DOUBLES_EQUAL(2e-4, a.status().x_re, 4.0 * a.status().sigma_v_per_v);
+}
+
+TEST(PumpEdgeCheck, APumpLeavingZeroWithinTheRowsBendsTheWaveAndTheStepIsReadThroughTheBend) {
+  // GIVEN r_x = 2e-4 V/V, the pump at 0 until 20 rows before the last
+  // pump-on row and at 3 V from then, the vibration growing by 3e-6 per V^2 and
+  // row while it runs (2.7e-5 V per row at 1 V: the parametric pump at its
+  // limit leaving the AGC's lower one)
+  EdgeFeed feed;
+  feed.r_x = {2e-4, 0.0};
+  feed.pump_rise_row = -20.0;
+  feed.growth_per_v2_row = 3e-6;
+  PumpEdgeCheck c(feed.cfg);
+  feed.run(c, 200, 100);
+  // THEN r is read within 3 of its stated sigmas (a line through the bent
+  // rows read x_re 1.38e-4, 4 of its sigmas off though the bend's misfit
+  // had tripled them), y none
+  const PumpEdgeStatus& s = c.status();
+  LONGS_EQUAL(1, s.edges);
+  DOUBLES_EQUAL(2e-4, s.x_re, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.x_im, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.y_re, 3.0 * s.sigma_v_per_v);
+  DOUBLES_EQUAL(0.0, s.y_im, 3.0 * s.sigma_v_per_v);
 }

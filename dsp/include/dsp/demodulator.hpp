@@ -82,6 +82,31 @@ constexpr double decimator_group_delay_samples(uint32_t block_frames) {
   return kDecimatorOrder * (static_cast<double>(block_frames) - 1.0) / 2.0;
 }
 
+// White input noise leaves successive outputs correlated (their windows,
+// N blocks long, overlap): sum over lags m of rho(m), the factor by which a
+// smooth combination of many outputs (a line through them, a mean) varies
+// more than if they were independent. Exact for the discrete filter h =
+// boxcar_L^N: its L polyphase sums are each L^(N-1), so sum_m R(mL) =
+// L^(2N-1), over R(0) = sum h^2 (the central coefficient of boxcar_L^(2N),
+// by inclusion-exclusion). 2.3233 for L = 100 (1 / B_10(0) = 2.3233 as L
+// grows); 1 for L = 1.
+inline double decimator_row_noise_correlation(uint32_t block_frames) {
+  const double l = static_cast<double>(block_frames);
+  const int n2 = 2 * static_cast<int>(kDecimatorOrder);
+  const auto choose = [](double a, int b) {
+    double c = 1.0;
+    for (int i = 1; i <= b; ++i)
+      c *= (a - b + i) / i;
+    return c;
+  };
+  const double m = kDecimatorOrder * (l - 1.0);
+  double sum_sq = 0.0;
+  double sign = 1.0;
+  for (int k = 0; k <= n2 && m - k * l >= 0.0; ++k, sign = -sign)
+    sum_sq += sign * choose(n2, k) * choose(m - k * l + n2 - 1.0, n2 - 1);
+  return std::pow(l, n2 - 1) / sum_sq;
+}
+
 // |H(f)| of the decimating filter in dB (<= 0) at input frequency f_hz:
 // 20 N log10 |sin(pi f L / fs) / (L sin(pi f / fs))|. For the 2f image pass
 // f = 2 f_resonance.

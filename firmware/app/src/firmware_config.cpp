@@ -99,6 +99,8 @@ void derive(FirmwareConfig& cfg, const ConverterLayout& conv) {
   cfg.estimator.pump.pump_lag_samples = pump_lag_samples(cfg.chain);
   const double l = static_cast<double>(cfg.chain.block_frames);
   cfg.gyro.pump_edge.row_centre_blocks = (1.0 + 0.5 * dsp::kDecimatorOrder * (l - 1.0)) / l;
+  cfg.gyro.pump_edge.row_noise_correlation =
+      dsp::decimator_row_noise_correlation(cfg.chain.block_frames);
 }
 
 can::EnvelopeReferenceConfig envelope_reference_config(const dsp::ChainConfig& chain,

@@ -8,15 +8,16 @@
 // switch-off the corrected quadratures X = cx - i sx, Y = cy - i sy are
 // referred to a fixed frame (the NCO's phase at the last pump-on row's
 // centre, advanced at its frequency then: the PLL's answer to a step does
-// not turn the frame) and fitted with a line on each side (the last pump-on
-// rows; the rows after the demodulator is free of the drive), and both lines
-// are taken to the switch instant. Their difference is -r P, r the residual
+// not turn the frame) and fitted on each side (the last pump-on rows with
+// the bend the pump's own V^2 puts in the vibration, fw::PumpOnFit; a line
+// through the rows after the demodulator is free of the drive), and both
+// fits are taken to the switch instant. Their difference is -r P, r the residual
 // feedthrough per volt of pump and P the pump envelope the pump-on rows saw
 // (ChainOutputs::pump_seen_v at the pump's phase against the NCO), weighted
-// as the line weights its rows at the instant (exact for a pump that varies,
+// as the fit weights its rows at the instant (exact for a pump that varies,
 // as the AGC's does): r = -dX / P per channel, averaged over the edges seen
 // since the correction last changed (weights from the fits' own residual
-// noise).
+// noise, times the rows' correlation).
 //
 // The step this leaves while the pump runs, |r| V0 (the larger channel),
 // turns the pattern angle read at amplitude a by up to |r| V0 / (2 a): it is
@@ -32,6 +33,7 @@
 #include <cstdint>
 
 #include "firmware/chain_and_identifier.hpp"
+#include "firmware/pump_on_fit.hpp"
 
 namespace hrg::fw {
 
@@ -53,6 +55,12 @@ struct PumpEdgeCheckConfig {
   // Readout error a step may cause while the pump runs (rad); 0.005 deg.
   double max_readout_step_rad = 8.726646259971648e-5;
   double n_sigma = 3.0;
+  // The rows' noise is the demodulator's: successive rows share input
+  // samples, so a line through them varies more than through independent
+  // rows by this factor (variance; dsp::decimator_row_noise_correlation,
+  // 2.3233 at the default 100-frame blocks; at 1 an edge's sigma is 1.52x
+  // too small).
+  double row_noise_correlation = 2.3233;
 };
 
 enum class PumpEdgeVerdict : uint8_t {
@@ -89,6 +97,10 @@ struct PumpEdgeStatus {
 class PumpEdgeCheck {
  public:
   static constexpr uint32_t kMaxFitRows = 64;
+  // The bend's 4 coefficients are kept when they take out of the pump-on
+  // rows' misfit more than F(4, 4 (n - 3)) at 0.1 % (4.7 at n = 64) times the
+  // rows' correlation says chance would.
+  static constexpr double kBendF = 4.7;
 
   explicit PumpEdgeCheck(const PumpEdgeCheckConfig& cfg);
   // The correction of the pickoffs changed: what was seen before is forgotten.
@@ -121,6 +133,13 @@ class PumpEdgeCheck {
   std::array<double, 4> in_frame(const std::array<double, 4>& q, uint32_t centre, double t) const;
   void begin_edge();
   void finish_edge();
+  // r of this edge through one pump-on fit, and that fit's misfit without it.
+  struct Reading {
+    std::array<double, 4> r{};
+    double p2 = 0.0;
+    double pre_rss = 0.0;
+  };
+  static Reading read(const PumpOnFit::Result& pre, const LineAt& post);
   void decide();
   // The mean's sigma from the edges' scatter (PumpEdgeStatus::scatter_v_per_v).
   double scatter() const;
@@ -144,10 +163,11 @@ class PumpEdgeCheck {
   // The edge being measured.
   bool in_edge_ = false;
   uint32_t off_rows_ = 0;  // rows since the last pump-on row
-  LineAt pre_{};
+  // The pump-on side as a line, and with the pump's bend (finish_edge keeps
+  // the bend where it explains the rows better than the line beyond chance).
+  PumpOnFit::Result pre_line_{};
+  PumpOnFit::Result pre_bend_{};
   LineSums post_{};
-  double pump_re_v_ = 0.0;
-  double pump_im_v_ = 0.0;
   double amplitude_v_ = 0.0;
   // The largest pump envelope of the edges since the last reset (V).
   double max_pump_v_ = 0.0;

@@ -373,7 +373,15 @@ class Resonator {
     double damp;  // damping scale - 1
   };
   HeldCoefficients prepare_held(double rate_rad_s, double temp_c, double dt_s);
-  double pump_delayed(double delay_samples) const;
+  // The pump delay_samples ago, interpolated as a sinusoid of step_rad per
+  // sample (the reference's): the history sample `whole` back and the one before.
+  struct PumpLag {
+    int whole = 0;
+    double w_whole = 1.0;
+    double w_next = 0.0;
+  };
+  static PumpLag pump_lag(double delay_samples, double step_rad);
+  double pump_delayed(const PumpLag& lag) const;
   // The pump history's position and running sum in locals over a loop of
   // steps (registers: the caller's stores could alias the members), the
   // same operations as push_pump(); back into the members by store().
@@ -483,6 +491,7 @@ class Resonator {
   // (a window fixed at construction would hold 20 samples, one period only
   // of a 5 kHz reference at 100 kHz, whatever the resonator's frequency).
   double dt_last_ = -1.0;
+  PumpLag quarter_lag_{};  // a quarter of the reference's period, at dt_last_
 };
 
 }  // namespace hrg::sim
