@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/cpputest.hpp"
+#include "support/decimator_taps.hpp"
 
 using namespace hrg::dsp;
 
@@ -239,14 +240,7 @@ TEST(Demodulator, RefusesABlockOfTheWrongSize) {
 TEST(Demodulator, TheRowsNoiseCorrelationIsThatOfItsOwnFilter) {
   // GIVEN the decimator's taps (boxcar_L^N) for L = 1, 4, 100
   for (uint32_t l : {1u, 4u, 100u}) {
-    std::vector<double> h{1.0};
-    for (uint32_t n = 0; n < kDecimatorOrder; ++n) {
-      std::vector<double> next(h.size() + l - 1, 0.0);
-      for (std::size_t i = 0; i < h.size(); ++i)
-        for (uint32_t j = 0; j < l; ++j)
-          next[i + j] += h[i];
-      h = next;
-    }
+    const std::vector<double> h = hrg::test::decimator_taps(l);
     // WHEN the correlation of outputs m blocks apart, R(mL) / R(0), is
     // summed over every lag
     double r0 = 0.0;

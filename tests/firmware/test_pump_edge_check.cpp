@@ -17,6 +17,7 @@
 #include "dsp/demodulator.hpp"
 
 #include "support/cpputest.hpp"
+#include "support/decimator_taps.hpp"
 
 using hrg::fw::ChainRecord;
 using hrg::fw::PumpEdgeCheck;
@@ -43,14 +44,7 @@ class Noise {
   static constexpr int kTaps = static_cast<int>(hrg::dsp::kDecimatorOrder) * (kBlock - 1) + 1;
 
   Noise() {
-    kernel_.assign(1, 1.0);
-    for (uint32_t n = 0; n < hrg::dsp::kDecimatorOrder; ++n) {
-      std::vector<double> next(kernel_.size() + kBlock - 1, 0.0);
-      for (std::size_t i = 0; i < kernel_.size(); ++i)
-        for (int j = 0; j < kBlock; ++j)
-          next[i + j] += kernel_[i];
-      kernel_ = next;
-    }
+    kernel_ = hrg::test::decimator_taps(kBlock);
     double sum_sq = 0.0;
     for (double h : kernel_)
       sum_sq += h * h;
