@@ -82,12 +82,16 @@ void EstimatorPort::restart_model() {
 
 void EstimatorPort::restart_after_correction(const est::PickoffSelfCalResult& applied) {
   restart_model();
-  self_cal_.refer_to_applied(applied);
+  refer_self_calibration(applied);
+  // The windows' levels changed with the correction, their decay did not:
+  // the damping model check keeps them.
+}
+
+void EstimatorPort::refer_self_calibration(const est::PickoffSelfCalResult& step) {
+  self_cal_.refer_to_applied(step);
   self_cal_result_ = {};
   self_cal_dirty_ = true;  // the re-referred residual, solved at the next solve()
   refresh_readout_figures();
-  // The windows' levels changed with the correction, their decay did not:
-  // the damping model check keeps them.
 }
 
 void EstimatorPort::add_sample(const ChainRecord& s) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `hrg audit --calibration` with the firmware's own estimates in the
-// recording's header (pump_edge_*, damping_check_*): read, refused when
+// recording's header (pump_edge_*, damping_check_*, self_cal_*): read, refused when
 // malformed, combined with the audit's by one rule.
 #include "audit/firmware_estimates.hpp"
 
@@ -204,4 +204,132 @@ TEST(FirmwareEstimates, TheThermalDampingIsCombinedByTheSameRule) {
                 1e-15);
   DOUBLES_EQUAL(1.0 / std::sqrt(wa + wf), c.file.sigma[8], 1e-18);
   CHECK_TRUE(has_comment(c, "thermal_damping", "weighted by inverse variance"));
+}
+
+namespace {
+
+constexpr double kDeg = kPi / 180.0;
+
+// A recording whose header carries the pickoff self-calibration's whole map:
+// the -1 deg misalignment row of the other resonator at seed 2 (365 s), the
+// firmware's -1.00026 +- 0.00035 deg, its gain and phase within their noise.
+hrg::recording::Recording with_self_cal_keys() {
+  hrg::recording::Recording rec({"t_s", "cx_v", "sx_v", "cy_v", "sy_v", "exc"}, 5000.0, 0.554);
+  const auto put = [&](const char* k, double v) {
+    rec.set_metadata(k, hrg::recording::format_number(v));
+  };
+  put("self_cal_gain", -1.36e-5);
+  put("self_cal_gain_sigma", 1.56e-5);
+  put("self_cal_misalignment_rad", -1.00026 * kDeg);
+  put("self_cal_misalignment_sigma_rad", 0.00035 * kDeg);
+  put("self_cal_phase_rad", -0.0012 * kDeg);
+  put("self_cal_phase_sigma_rad", 0.00074 * kDeg);
+  return rec;
+}
+
+Finding pickoff_finding(Effect e, double value, double sigma) {
+  Finding f;
+  f.effect = e;
+  f.value = value;
+  f.sigma = sigma;
+  return f;
+}
+
+}  // namespace
+
+TEST(FirmwareEstimates, ThePickoffMapsKeysAreReadWithEachPartsSigma) {
+  const auto e = hrg::audit::firmware_estimates(with_self_cal_keys(), "rec.csv");
+  CHECK_TRUE(e.pickoff.has_value());
+  CHECK_FALSE(e.feedthrough.has_value());
+  DOUBLES_EQUAL(-1.36e-5, e.pickoff->gain.value, 1e-20);
+  DOUBLES_EQUAL(1.56e-5, e.pickoff->gain.sigma, 1e-20);
+  DOUBLES_EQUAL(-1.00026 * kDeg, e.pickoff->misalignment_rad.value, 1e-18);
+  DOUBLES_EQUAL(0.00035 * kDeg, e.pickoff->misalignment_rad.sigma, 1e-20);
+  DOUBLES_EQUAL(-0.0012 * kDeg, e.pickoff->phase_rad.value, 1e-20);
+  DOUBLES_EQUAL(0.00074 * kDeg, e.pickoff->phase_rad.sigma, 1e-20);
+  // AND a recording without them has none
+  CHECK_FALSE(hrg::audit::firmware_estimates(with_pump_edge_keys(), "rec.csv").pickoff);
+}
+
+TEST(FirmwareEstimates, AMalformedOrMissingPickoffKeyIsRefusedByName) {
+  const std::array<std::array<const char*, 2>, 6> bad{{
+      {"self_cal_gain", "-1.5"},  // no inverse
+      {"self_cal_gain_sigma", "0"},
+      {"self_cal_misalignment_rad", "inf"},
+      {"self_cal_misalignment_sigma_rad", ""},  // missing, the rest of its group there
+      {"self_cal_phase_rad", "0.01x"},
+      {"self_cal_phase_sigma_rad", "-1e-5"},
+  }};
+  for (const auto& [key, value] : bad) {
+    auto rec = with_self_cal_keys();
+    rec.set_metadata(key, value);
+    try {
+      (void)hrg::audit::firmware_estimates(rec, "rec.csv");
+      FAIL("a malformed header key was accepted");
+    } catch (const std::runtime_error& e) {
+      CHECK_TRUE(std::string(e.what()).find(std::string("'") + key + "'") != std::string::npos);
+    }
+  }
+}
+
+TEST(FirmwareEstimates, AnAcceptedPickoffPartIsWeighedWithTheFirmwaresAndTheOthersAreNotApplied) {
+  // GIVEN the audit's misalignment -0.99907 +- 0.00051 deg (its only
+  // pickoff finding) and the firmware's map (-1.00026 +- 0.00035 deg)
+  AuditResult r;
+  r.verdict = "explained";
+  r.findings.push_back(pickoff_finding(Effect::pickoff_misalignment, -0.99907, 0.00051));
+  hrg::audit::CalibrationWriterOptions opt;
+  const auto plain = hrg::audit::calibration_from_audit(r, "rec.csv", opt);
+  opt.firmware = hrg::audit::firmware_estimates(with_self_cal_keys(), "rec.csv");
+  const auto c = hrg::audit::calibration_from_audit(r, "rec.csv", opt);
+  // THEN the file's misalignment is the inverse-variance mean, -0.99988
+  // deg, between the two, its sigma 0.00029 deg below both
+  const double wa = 1.0 / (0.00051 * 0.00051), wf = 1.0 / (0.00035 * 0.00035);
+  const double mean_deg = (wa * -0.99907 + wf * -1.00026) / (wa + wf);
+  const double b_deg = c.file.calibration.pickoff_y_misalignment_rad / kDeg;
+  DOUBLES_EQUAL(mean_deg, b_deg, 1e-12);
+  DOUBLES_EQUAL(-0.99988, b_deg, 2e-6);
+  CHECK(b_deg < -0.99907 && b_deg > -1.00026);
+  const double sigma_deg = c.file.sigma[2] / kDeg;  // pickoff_y_misalignment_rad
+  DOUBLES_EQUAL(1.0 / std::sqrt(wa + wf), sigma_deg, 1e-12);
+  CHECK(sigma_deg < 0.00035);
+  CHECK_TRUE(has_comment(c, "pickoff_misalignment", "weighted by inverse variance"));
+  // AND the gain and phase the audit did not accept stay 0, said, not applied
+  DOUBLES_EQUAL(0.0, c.file.calibration.pickoff_y_gain, 0.0);
+  DOUBLES_EQUAL(0.0, c.file.calibration.pickoff_y_phase_rad, 0.0);
+  CHECK_TRUE(has_comment(c, "not applied", "pickoff_gain_mismatch -1.36e-05 +- 1.6e-05;"));
+  CHECK_TRUE(has_comment(c, "not applied", "pickoff_phase_mismatch -0.0012 +- 0.00074 deg"));
+  CHECK_FALSE(has_comment(c, "not applied", "pickoff_misalignment"));
+  // AND without the keys the file is the audit's, as before
+  DOUBLES_EQUAL(-0.99907, plain.file.calibration.pickoff_y_misalignment_rad / kDeg, 1e-12);
+  DOUBLES_EQUAL(0.00051, plain.file.sigma[2] / kDeg, 1e-12);
+  CHECK_FALSE(has_comment(plain, "self-calibration", ""));
+}
+
+TEST(FirmwareEstimates, EachPickoffPartIsCombinedWithItsOwnSigma) {
+  // GIVEN the audit's gain 0.0101 +- 7e-5 and phase 1.0000 +- 0.004 deg,
+  // the firmware's 0.01003 +- 2e-5 and 0.9990 +- 0.001 deg
+  AuditResult r;
+  r.verdict = "explained";
+  r.findings.push_back(pickoff_finding(Effect::pickoff_gain_mismatch, 0.0101, 7e-5));
+  r.findings.push_back(pickoff_finding(Effect::pickoff_phase_mismatch, 1.0, 0.004));
+  auto rec = with_self_cal_keys();
+  rec.set_metadata("self_cal_gain", "0.01003");
+  rec.set_metadata("self_cal_gain_sigma", "2e-5");
+  rec.set_metadata("self_cal_phase_rad", hrg::recording::format_number(0.999 * kDeg));
+  rec.set_metadata("self_cal_phase_sigma_rad", hrg::recording::format_number(0.001 * kDeg));
+  hrg::audit::CalibrationWriterOptions opt;
+  opt.firmware = hrg::audit::firmware_estimates(rec, "rec.csv");
+  const auto c = hrg::audit::calibration_from_audit(r, "rec.csv", opt);
+  // THEN each part is its own inverse-variance mean
+  const auto mean = [](double a, double sa, double f, double sf) {
+    return (a / (sa * sa) + f / (sf * sf)) / (1.0 / (sa * sa) + 1.0 / (sf * sf));
+  };
+  DOUBLES_EQUAL(mean(0.0101, 7e-5, 0.01003, 2e-5), c.file.calibration.pickoff_y_gain, 1e-15);
+  DOUBLES_EQUAL(mean(1.0, 0.004, 0.999, 0.001), c.file.calibration.pickoff_y_phase_rad / kDeg,
+                1e-12);
+  DOUBLES_EQUAL(1.0 / std::sqrt(1.0 / 49e-10 + 1.0 / 4e-10), c.file.sigma[0], 1e-18);
+  // AND the misalignment the audit did not accept is said, not applied
+  DOUBLES_EQUAL(0.0, c.file.calibration.pickoff_y_misalignment_rad, 0.0);
+  CHECK_TRUE(has_comment(c, "not applied", "pickoff_misalignment -1.00026 +- 0.00035 deg"));
 }

@@ -161,6 +161,13 @@ TEST(DbcAgreesWithCode, FramesEncodedByTheFirmwareDecodeThroughTheDbc) {
   s.estimates.thermal_damping = true;
   s.estimates.thermal_damping_per_c = 0.2;
   s.estimates.thermal_damping_sigma_per_c = 1.5e-4;
+  s.estimates.pickoff = true;
+  s.estimates.pickoff_gain = -0.2;
+  s.estimates.pickoff_gain_sigma = 6e-7;
+  s.estimates.pickoff_misalignment_rad = -0.0174578;
+  s.estimates.pickoff_misalignment_sigma_rad = 6.1e-6;
+  s.estimates.pickoff_phase_rad = 0.349;
+  s.estimates.pickoff_phase_sigma_rad = 1.3e-5;
   const auto* readings = dbc().message("HRG_CAL_READINGS");
   CHECK(readings != nullptr);
   const auto at = [&](uint8_t page, const char* name) {
@@ -177,6 +184,13 @@ TEST(DbcAgreesWithCode, FramesEncodedByTheFirmwareDecodeThroughTheDbc) {
   DOUBLES_EQUAL(3.998e-4, at(5, "pump_edge_in_force_y_im_v_per_v"), 1e-8);
   DOUBLES_EQUAL(0.2, at(6, "thermal_damping_per_c"), 5e-8);
   DOUBLES_EQUAL(1, at(6, "thermal_valid"), 0);
+  DOUBLES_EQUAL(-0.2, at(7, "self_cal_gain"), 2e-9);
+  DOUBLES_EQUAL(6e-7, at(7, "self_cal_gain_sigma"), 1e-9);
+  DOUBLES_EQUAL(-0.0174578, at(8, "self_cal_misalignment_rad"), 2e-9);
+  DOUBLES_EQUAL(6.1e-6, at(8, "self_cal_misalignment_sigma_rad"), 1e-9);
+  DOUBLES_EQUAL(0.349, at(9, "self_cal_phase_rad"), 2e-9);
+  DOUBLES_EQUAL(1.3e-5, at(9, "self_cal_phase_sigma_rad"), 1e-9);
+  DOUBLES_EQUAL(1, at(9, "self_cal_valid"), 0);
   encode_cal_readings(s.estimates, 1, 5, f);
   CHECK_FALSE(readings->present(*readings->signal("pump_edge_edges"), f));
   CHECK(readings->present(*readings->signal("seq"), f));

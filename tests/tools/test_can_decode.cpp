@@ -55,6 +55,13 @@ TelemetrySnapshot sample(int k) {
   e.thermal_damping = true;
   e.thermal_damping_per_c = 0.0039;
   e.thermal_damping_sigma_per_c = 1.5e-4;
+  e.pickoff = true;
+  e.pickoff_gain = 0.01 + 1e-8 * k;
+  e.pickoff_gain_sigma = 6e-7;
+  e.pickoff_misalignment_rad = -0.0174578;
+  e.pickoff_misalignment_sigma_rad = 6.1e-6;
+  e.pickoff_phase_rad = 0.0174533;
+  e.pickoff_phase_sigma_rad = 1.3e-5;
   return s;
 }
 
@@ -226,16 +233,16 @@ double key(const hrg::recording::Recording& rec, const char* k) {
 
 TEST(CanDecode, TheLastCompleteSetOfTheFirmwareReadingsBecomesTheHeaderKeys) {
   // GIVEN two seconds of telemetry: HRG_CAL_READINGS sets start at frames
-  // 86, 786 and 1486 (10 Hz, 7 pages); the third has 6 pages when the log ends
+  // 86 and 1086 (10 Hz, 10 pages), the second's last page at frame 1986
   const std::string log = write_log({});
   const hrg::can::CanDecodeOptions o = options(log, "test_can_decode_readings.csv");
   // WHEN it is decoded
   const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
-  // THEN the keys are the second set's, held at its first page (frame 786)
+  // THEN the keys are the second set's, held at its first page (frame 1086)
   LONGS_EQUAL(2, s.cal_readings_sets);
   const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
-  const TelemetrySnapshot at = sample(786);
-  LONGS_EQUAL(8, static_cast<long>(key(rec, "pump_edge_edges")));
+  const TelemetrySnapshot at = sample(1086);
+  LONGS_EQUAL(11, static_cast<long>(key(rec, "pump_edge_edges")));
   DOUBLES_EQUAL(at.estimates.in_force_s, key(rec, "pump_edge_in_force_s"), 0.005);
   DOUBLES_EQUAL(at.estimates.feedthrough_residual_v_per_v.x_re, key(rec, "pump_edge_x_re_v_per_v"),
                 1e-8);
@@ -246,6 +253,13 @@ TEST(CanDecode, TheLastCompleteSetOfTheFirmwareReadingsBecomesTheHeaderKeys) {
   DOUBLES_EQUAL(-2e-5, key(rec, "pump_edge_in_force_y_im_v_per_v"), 1e-8);
   DOUBLES_EQUAL(0.0039, key(rec, "damping_check_thermal_damping_per_c"), 5e-8);
   DOUBLES_EQUAL(1.5e-4, key(rec, "damping_check_thermal_damping_sigma_per_c"), 5e-9);
+  // ... and the pickoff map's, each within half its resolution (4e-9, 2e-9)
+  DOUBLES_EQUAL(at.estimates.pickoff_gain, key(rec, "self_cal_gain"), 2e-9);
+  DOUBLES_EQUAL(6e-7, key(rec, "self_cal_gain_sigma"), 1e-9);
+  DOUBLES_EQUAL(-0.0174578, key(rec, "self_cal_misalignment_rad"), 2e-9);
+  DOUBLES_EQUAL(6.1e-6, key(rec, "self_cal_misalignment_sigma_rad"), 1e-9);
+  DOUBLES_EQUAL(0.0174533, key(rec, "self_cal_phase_rad"), 2e-9);
+  DOUBLES_EQUAL(1.3e-5, key(rec, "self_cal_phase_sigma_rad"), 1e-9);
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
 }
@@ -253,7 +267,7 @@ TEST(CanDecode, TheLastCompleteSetOfTheFirmwareReadingsBecomesTheHeaderKeys) {
 TEST(CanDecode, ASetWithALostPageIsNotUsedAndWithoutACompleteSetNoKeyIsWritten) {
   const int rd = static_cast<int>(Tm::cal_readings);
   // GIVEN the second set's page 2 lost: the first set is the last complete one
-  std::string log = write_log({{rd, 9}});
+  std::string log = write_log({{rd, 12}});
   hrg::can::CanDecodeOptions o = options(log, "test_can_decode_partial.csv");
   hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
   LONGS_EQUAL(1, s.cal_readings_sets);
@@ -261,21 +275,21 @@ TEST(CanDecode, ASetWithALostPageIsNotUsedAndWithoutACompleteSetNoKeyIsWritten) 
   hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
   LONGS_EQUAL(1, static_cast<long>(key(rec, "pump_edge_edges")));  // held at frame 86
   // GIVEN a page of each set lost: no complete set, no key, nothing guessed
-  log = write_log({{rd, 3}, {rd, 9}});
+  log = write_log({{rd, 3}, {rd, 12}});
   s = hrg::can::can_decode(o);
   LONGS_EQUAL(0, s.cal_readings_sets);
   CHECK_FALSE(s.estimates.has_value());
   rec = hrg::recording::read_recording(o.out_path);
   for (const char* k : {"pump_edge_edges", "pump_edge_x_re_v_per_v", "pump_edge_in_force_s",
-                        "damping_check_thermal_damping_per_c"}) {
+                        "damping_check_thermal_damping_per_c", "self_cal_gain"}) {
     CHECK_TEXT(rec.metadata_value(k).empty(), k);
   }
   std::remove(log.c_str());
   std::remove(o.out_path.c_str());
 }
 
-TEST(CanDecode, WithoutAFeedthroughOrThermalReadingTheirKeysAreLeftOut) {
-  // GIVEN a set sent with no edge and no thermal reading
+TEST(CanDecode, WithoutAFeedthroughThermalOrPickoffReadingTheirKeysAreLeftOut) {
+  // GIVEN a set sent with no edge, no thermal reading and no pickoff map
   const std::string path = "test_can_decode_none.log";
   {
     hrg::can::CandumpLogWriter w(path);
@@ -304,12 +318,13 @@ TEST(CanDecode, WithoutAFeedthroughOrThermalReadingTheirKeysAreLeftOut) {
   const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
   CHECK_TRUE(rec.metadata_value("pump_edge_edges").empty());
   CHECK_TRUE(rec.metadata_value("damping_check_thermal_damping_per_c").empty());
+  CHECK_TRUE(rec.metadata_value("self_cal_gain").empty());
   std::remove(path.c_str());
   std::remove(o.out_path.c_str());
 }
 
 TEST(CanDecode, AReadingOutsideItsRangeIsRefusedNamingTheMessageTheSignalAndTheLine) {
-  // GIVEN a log whose third line is HRG_CAL_READINGS with page 9 (the DBC's 0-6)
+  // GIVEN a log whose third line is HRG_CAL_READINGS with page 11 (the DBC's 0-9)
   const std::string path = "test_can_decode_bad.log";
   {
     hrg::can::CandumpLogWriter w(path);
@@ -318,7 +333,7 @@ TEST(CanDecode, AReadingOutsideItsRangeIsRefusedNamingTheMessageTheSignalAndTheL
     w.write(f, kT0Ns);
     encode_cal_readings(FirmwareEstimates{}, 1, 1, f);
     w.write(f, kT0Ns + 1);
-    f.data[0] = static_cast<uint8_t>((f.data[0] & 0xF0u) | 9u);
+    f.data[0] = static_cast<uint8_t>((f.data[0] & 0xF0u) | 11u);
     w.write(f, kT0Ns + 2);
   }
   try {
@@ -326,8 +341,8 @@ TEST(CanDecode, AReadingOutsideItsRangeIsRefusedNamingTheMessageTheSignalAndTheL
     FAIL("decoded a page out of range");
   } catch (const std::runtime_error& e) {
     STRCMP_CONTAINS("test_can_decode_bad.log:3:", e.what());
-    STRCMP_CONTAINS("HRG_CAL_READINGS signal 'page' = 9", e.what());
-    STRCMP_CONTAINS("outside its range [0, 6]", e.what());
+    STRCMP_CONTAINS("HRG_CAL_READINGS signal 'page' = 11", e.what());
+    STRCMP_CONTAINS("outside its range [0, 9]", e.what());
   }
   std::remove(path.c_str());
 }

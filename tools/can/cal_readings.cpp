@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "firmware/can/messages.hpp"
-
 namespace hrg::can {
 
 namespace {
@@ -55,7 +53,9 @@ void CalReadingsReader::add(const DbcMessage& m, const hal::CanFrame& f, const s
     if (m.present(s, f) && &s != seq_sig && &s != page_sig) values_[s.name] = s.decode(f);
   last_seq_ = seq;
   next_page_ = page + 1;
-  if (next_page_ < fw::can::kCalReadingsPages) return;
+  // A set is as many pages as the DBC's multiplexor holds: a log of
+  // protocol 4 (pages 0-6) decodes with its own DBC.
+  if (next_page_ <= static_cast<int>(page_sig->max)) return;
   last_ = estimates(values_);
   ++complete_;
   next_page_ = 0;
@@ -83,6 +83,15 @@ fw::can::FirmwareEstimates CalReadingsReader::estimates(const std::map<std::stri
   e.thermal_damping = at("thermal_valid") != 0.0;
   e.thermal_damping_per_c = at("thermal_damping_per_c");
   e.thermal_damping_sigma_per_c = at("thermal_damping_sigma_per_c");
+  // Protocol 5 on: the pickoff self-calibration's map (none before).
+  if (v.count("self_cal_valid") == 0) return e;
+  e.pickoff = at("self_cal_valid") != 0.0;
+  e.pickoff_gain = at("self_cal_gain");
+  e.pickoff_gain_sigma = at("self_cal_gain_sigma");
+  e.pickoff_misalignment_rad = at("self_cal_misalignment_rad");
+  e.pickoff_misalignment_sigma_rad = at("self_cal_misalignment_sigma_rad");
+  e.pickoff_phase_rad = at("self_cal_phase_rad");
+  e.pickoff_phase_sigma_rad = at("self_cal_phase_sigma_rad");
   return e;
 }
 

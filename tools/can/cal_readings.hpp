@@ -13,7 +13,8 @@
 namespace hrg::can {
 
 // Puts the pages of HRG_CAL_READINGS back together (firmware/can/README.md):
-// a set is pages 0 to 6 in order with consecutive `seq`; a page out of
+// a set is pages 0 to the DBC multiplexor's largest (9; 6 before protocol
+// 5) in order with consecutive `seq`; a page out of
 // turn or a lost frame drops the set being read (never mixed with another).
 // The last complete set is the firmware's readings; none when the log has
 // no complete set (nothing is guessed from a partial one).

@@ -31,6 +31,14 @@ std::vector<std::pair<std::string, std::string>> estimates_header(
     put("damping_check_thermal_damping_per_c", e.thermal_damping_per_c);
     put("damping_check_thermal_damping_sigma_per_c", e.thermal_damping_sigma_per_c);
   }
+  if (e.pickoff) {
+    put("self_cal_gain", e.pickoff_gain);
+    put("self_cal_gain_sigma", e.pickoff_gain_sigma);
+    put("self_cal_misalignment_rad", e.pickoff_misalignment_rad);
+    put("self_cal_misalignment_sigma_rad", e.pickoff_misalignment_sigma_rad);
+    put("self_cal_phase_rad", e.pickoff_phase_rad);
+    put("self_cal_phase_sigma_rad", e.pickoff_phase_sigma_rad);
+  }
   return meta;
 }
 

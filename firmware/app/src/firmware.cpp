@@ -119,6 +119,19 @@ can::FirmwareEstimates Firmware::estimates() const {
   e.thermal_damping = thermal.valid;
   e.thermal_damping_per_c = thermal.per_c;
   e.thermal_damping_sigma_per_c = thermal.sigma_per_c;
+  // The pickoff map only where the firmware would stand behind it: a
+  // damping that changes between the windows reads as a level pattern.
+  const est::PickoffSelfCalResult& r = estimator_.pickoff_self_calibration();
+  if (r.status == est::Status::ok && r.decay_consistent) {
+    const est::PickoffMapEstimate m = est::whole_estimate(pickoff_map(in_force), r);
+    e.pickoff = true;
+    e.pickoff_gain = m.value.gain;
+    e.pickoff_gain_sigma = m.sigma.gain;
+    e.pickoff_misalignment_rad = m.value.misalignment_rad;
+    e.pickoff_misalignment_sigma_rad = m.sigma.misalignment_rad;
+    e.pickoff_phase_rad = m.value.phase_rad;
+    e.pickoff_phase_sigma_rad = m.sigma.phase_rad;
+  }
   return e;
 }
 
@@ -173,6 +186,17 @@ est::PickoffMap Firmware::pickoff_map_to_keep() const {
   return est::evidence_weighted_map(in_force, r);
 }
 
+void Firmware::refer_self_calibration_to_raw(const est::PickoffMap& withdrawn) {
+  if (withdrawn == est::PickoffMap{}) return;
+  // The self-calibration's windows so far were read through the map
+  // withdrawn: mixed with the raw ones after it, its residual would be of
+  // neither (a 1 deg phase lag with half of it withdrawn read 0.657 +- 0.003
+  // deg).
+  est::PickoffSelfCalResult ok;
+  ok.status = est::Status::ok;
+  estimator_.refer_self_calibration(est::step_between(withdrawn, {}, ok));
+}
+
 void Firmware::judge_calibration() {
   judge_calibration_parts();
   const CalibrationStatus& c = guard_.status();
@@ -187,9 +211,11 @@ void Firmware::judge_calibration_parts() {
   if (guard_.judge(estimator_.health(), checking(), t_s, st.pump_edge.verdict)) {
     // The chain goes back to the raw pickoffs; the verdict stays reported.
     // A seed's model kept beside a damping part takes over.
+    const est::PickoffMap withdrawn = pickoff_map(cfg_.calibration);
     chain_.clear_electronics_correction();
     estimator_.fall_back_to_seed_model();
     put_in_force(kIdentityCalibration, true);
+    refer_self_calibration_to_raw(withdrawn);
     return;
   }
   const est::DampingModelCheckResult& d = estimator_.damping_model_check();

@@ -129,6 +129,23 @@ constexpr SignalDef ft_sigma(const char* name, uint8_t start) {
   return {name, start, 24, false, kSigmaFactor, 0, 0, kU24 * kSigmaFactor, "V/V",
           MuxRole::multiplexed, 3};
 }
+// The pickoff map's parts (-, rad): 4e-9 (1/150 of the gain's sigma at
+// 1800 s, ~6e-7), +-0.537 (the calibration's ranges: gain +-0.2,
+// misalignment +-0.175 rad, phase +-0.349 rad); their sigmas 2e-9 up to
+// 2.1e-3 (saturates: a reading that imprecise weighs nothing against the
+// audit's, gain ~7e-5, misalignment ~9e-6 rad at 365 s).
+constexpr double kMapFactor = 4e-9;
+constexpr double kMapSigmaFactor = 2e-9;
+constexpr double kS28 = 134217728.0;  // 2^27
+constexpr double kU20 = 1048575.0;    // 2^20 - 1
+constexpr SignalDef map_part(const char* name, const char* unit, uint8_t page) {
+  return {name, 8, 28, true, kMapFactor, 0, -kS28 * kMapFactor, (kS28 - 1) * kMapFactor, unit,
+          MuxRole::multiplexed, page};
+}
+constexpr SignalDef map_sigma(const char* name, const char* unit, uint8_t page) {
+  return {name, 36, 20, false, kMapSigmaFactor, 0, 0, kU20 * kMapSigmaFactor, unit,
+          MuxRole::multiplexed, page};
+}
 constexpr auto kMux = MuxRole::multiplexed;
 constexpr SignalDef kCalReadings[] = {
   {"page", 0, 4, false, 1, 0, 0, kCalReadingsPages - 1, "", MuxRole::multiplexor},
@@ -149,6 +166,13 @@ constexpr SignalDef kCalReadings[] = {
   {"thermal_damping_per_c", 8, 24, true, 1e-7, 0, -kS24 * 1e-7, (kS24 - 1) * 1e-7, "1/degC",
    kMux, 6},
   {"thermal_damping_sigma_per_c", 32, 24, false, 1e-8, 0, 0, kU24 * 1e-8, "1/degC", kMux, 6},
+  {"self_cal_valid", 5, 1, false, 1, 0, 0, 1, ""},
+  map_part("self_cal_gain", "", 7),
+  map_sigma("self_cal_gain_sigma", "", 7),
+  map_part("self_cal_misalignment_rad", "rad", 8),
+  map_sigma("self_cal_misalignment_sigma_rad", "rad", 8),
+  map_part("self_cal_phase_rad", "rad", 9),
+  map_sigma("self_cal_phase_sigma_rad", "rad", 9),
 };
 // The test bench's rate table and thermal chamber (not the gyro).
 constexpr SignalDef kLabTableSignals[] = {

@@ -142,10 +142,13 @@ void encode_cal_readings(const FirmwareEstimates& e, uint8_t page, uint8_t seq, 
   f.len = m.dlc;
   put(m, sig::readings_page, page, f);
   put(m, sig::thermal_valid, b(e.thermal_damping), f);
+  put(m, sig::self_cal_valid, b(e.pickoff), f);
   put_bits(f, m.signals[sig::readings_seq].start_bit, kSeqBits, seq);
   // Without an edge the feedthrough signals stay zero (0 edges says so).
   const FirmwareEstimates none{};
   const FirmwareEstimates& ft = e.feedthrough ? e : none;
+  // Without a pickoff map its signals stay zero (self_cal_valid says so).
+  const FirmwareEstimates& map = e.pickoff ? e : none;
   const auto pair = [&](std::size_t a, double va, std::size_t b2, double vb) {
     put(m, a, va, f);
     put(m, b2, vb, f);
@@ -174,10 +177,21 @@ void encode_cal_readings(const FirmwareEstimates& e, uint8_t page, uint8_t seq, 
       pair(sig::pump_edge_in_force_y_re, ft.feedthrough_in_force_v_per_v.y_re,
            sig::pump_edge_in_force_y_im, ft.feedthrough_in_force_v_per_v.y_im);
       break;
-    default:
+    case 6:
       pair(sig::thermal_damping_per_c, e.thermal_damping ? e.thermal_damping_per_c : 0.0,
            sig::thermal_damping_sigma_per_c,
            e.thermal_damping ? e.thermal_damping_sigma_per_c : 0.0);
+      break;
+    case 7:
+      pair(sig::self_cal_gain, map.pickoff_gain, sig::self_cal_gain_sigma, map.pickoff_gain_sigma);
+      break;
+    case 8:
+      pair(sig::self_cal_misalignment, map.pickoff_misalignment_rad,
+           sig::self_cal_misalignment_sigma, map.pickoff_misalignment_sigma_rad);
+      break;
+    default:
+      pair(sig::self_cal_phase, map.pickoff_phase_rad, sig::self_cal_phase_sigma,
+           map.pickoff_phase_sigma_rad);
       break;
   }
 }

@@ -95,6 +95,10 @@ class EstimatorPort final : public ResonatorIdentifier {
   // window; the self-calibration keeps them, re-referred through it
   // (est::PickoffSelfCalibration::refer_to_applied).
   void restart_after_correction(const est::PickoffSelfCalResult& applied);
+  // The pickoff correction changed by `step` while the model keeps its
+  // windows (a calibration withdrawn): the self-calibration's windows are
+  // re-referred through it, so its residual stays one of the map in force.
+  void refer_self_calibration(const est::PickoffSelfCalResult& step);
   // The gap harmonic a calibration gives (both zero: not known, fitted
   // online), with its own sigmas (0: not given). Kept across restart();
   // changes no window.

@@ -360,6 +360,15 @@ FirmwareEstimates some_readings() {
   e.thermal_damping = true;
   e.thermal_damping_per_c = -0.00391;
   e.thermal_damping_sigma_per_c = 1.5e-4;
+  // The pickoff self-calibration's map: the -1 deg misalignment row's, the
+  // phase at the calibration's range end (20 deg).
+  e.pickoff = true;
+  e.pickoff_gain = -1.3582e-5;
+  e.pickoff_gain_sigma = 1.5586e-5;
+  e.pickoff_misalignment_rad = -0.0174577920;
+  e.pickoff_misalignment_sigma_rad = 6.1069e-6;
+  e.pickoff_phase_rad = 0.3490658504;
+  e.pickoff_phase_sigma_rad = 1.2957e-5;
   return e;
 }
 
@@ -369,7 +378,7 @@ double read(const CanFrame& f, const char* name) {
 
 }  // namespace
 
-TEST(Telemetry, TheCalibrationReadingsGoOutAsOneSetOfSevenPagesFromTheSameReadings) {
+TEST(Telemetry, TheCalibrationReadingsGoOutAsOneSetOfTenPagesFromTheSameReadings) {
   // GIVEN the default rates and the firmware's readings in the snapshot
   TelemetryEncoder enc(TelemetryConfig::defaults(), 1000);
   TelemetrySnapshot s;
@@ -378,8 +387,8 @@ TEST(Telemetry, TheCalibrationReadingsGoOutAsOneSetOfSevenPagesFromTheSameReadin
   std::array<CanFrame, kCalReadingsPages> set{};
   int pages = 0;
   int due_seen = 0;
-  // WHEN 0.7 s of base frames run, the readings changed after the set began
-  for (int k = 0; k < 700; ++k) {
+  // WHEN 1 s of base frames run, the readings changed after the set began
+  for (int k = 0; k < 1000; ++k) {
     const bool due = enc.cal_readings_due();
     due_seen += due ? 1 : 0;
     if (k == 150) s.estimates.edges = 35;  // held: the set keeps 34
@@ -414,19 +423,43 @@ TEST(Telemetry, TheCalibrationReadingsGoOutAsOneSetOfSevenPagesFromTheSameReadin
   DOUBLES_EQUAL(-3.14e-7, read(set[5], "pump_edge_in_force_y_im_v_per_v"), ft);
   DOUBLES_EQUAL(e.thermal_damping_per_c, read(set[6], "thermal_damping_per_c"), 5e-8);
   DOUBLES_EQUAL(e.thermal_damping_sigma_per_c, read(set[6], "thermal_damping_sigma_per_c"), 5e-9);
-  for (const auto& f : set)
+  const double map = 2e-9;  // half of 4e-9 (-, rad)
+  const double map_sigma = 1e-9;
+  DOUBLES_EQUAL(e.pickoff_gain, read(set[7], "self_cal_gain"), map);
+  DOUBLES_EQUAL(e.pickoff_gain_sigma, read(set[7], "self_cal_gain_sigma"), map_sigma);
+  DOUBLES_EQUAL(e.pickoff_misalignment_rad, read(set[8], "self_cal_misalignment_rad"), map);
+  DOUBLES_EQUAL(e.pickoff_misalignment_sigma_rad, read(set[8], "self_cal_misalignment_sigma_rad"),
+                map_sigma);
+  DOUBLES_EQUAL(e.pickoff_phase_rad, read(set[9], "self_cal_phase_rad"), map);
+  DOUBLES_EQUAL(e.pickoff_phase_sigma_rad, read(set[9], "self_cal_phase_sigma_rad"), map_sigma);
+  for (const auto& f : set) {
     DOUBLES_EQUAL(1, read(f, "thermal_valid"), 0);
+    DOUBLES_EQUAL(1, read(f, "self_cal_valid"), 0);
+  }
 }
 
-TEST(Telemetry, NoReadingIsSentAsNoEdgesAndThermalNotValid) {
+TEST(Telemetry, APickoffSigmaAboveItsRangeSaturatesAtTheRangesEnd) {
+  // GIVEN a gain sigma of 0.01, above the signal's 2.1e-3
+  FirmwareEstimates e = some_readings();
+  e.pickoff_gain_sigma = 0.01;
+  CanFrame f;
+  encode_cal_readings(e, 7, 0, f);
+  // THEN it reads as the range's end, (2^20 - 1) 2e-9, the gain untouched
+  DOUBLES_EQUAL(1048575 * 2e-9, read(f, "self_cal_gain_sigma"), 1e-15);
+  DOUBLES_EQUAL(e.pickoff_gain, read(f, "self_cal_gain"), 2e-9);
+}
+
+TEST(Telemetry, NoReadingIsSentAsNoEdgesAndNeitherThermalNorPickoffMapValid) {
   FirmwareEstimates e = some_readings();
   e.feedthrough = false;
   e.thermal_damping = false;
+  e.pickoff = false;
   for (uint8_t page = 0; page < kCalReadingsPages; ++page) {
     CanFrame f;
     encode_cal_readings(e, page, 3, f);
     LONGS_EQUAL(page, static_cast<long>(read(f, "page")));
     DOUBLES_EQUAL(0, read(f, "thermal_valid"), 0);
+    DOUBLES_EQUAL(0, read(f, "self_cal_valid"), 0);
     // Every byte but the page/flags byte and seq is zero: nothing stale.
     for (int b = 1; b < 7; ++b)
       LONGS_EQUAL(0, f.data[b]);

@@ -3,7 +3,7 @@
 """The firmware's own readings through CAN against telemetry.csv.
 
 `hrg sim --can-log` with a calibration in force -> `hrg can-decode`: the
-decoded recording's pump_edge_* / damping_check_* keys are the ones hrg sim
+decoded recording's pump_edge_* / damping_check_* / self_cal_* keys are the ones hrg sim
 writes into telemetry.csv, within the CAN resolution (firmware/can/README.md,
 HRG_CAL_READINGS); `hrg audit REC --calibration OUT.toml` on both writes the
 same feedthrough, combined with the switch-off step check's reading, within
@@ -24,7 +24,10 @@ from compare import run  # the same runner and exit-status rule as the audit com
 
 RES_FT = 2e-8  # V/V, the feedthrough signals' resolution
 RES_SIGMA = 1e-9  # V/V, their sigma's
-SET_PERIOD_S = 0.7  # one set of 7 pages at 10 Hz, held from its first page
+SET_PERIOD_S = 1.0  # one set of 10 pages at 10 Hz, held from its first page
+RES_MAP = 4e-9  # the pickoff map's parts (-, rad)
+RES_MAP_SIGMA = 2e-9  # their sigmas'
+PREFIXES = ("pump_edge_", "damping_check_", "self_cal_")
 PARTS = ("x_re", "x_im", "y_re", "y_im")
 
 
@@ -55,11 +58,13 @@ def tolerance(key):
         return 0.5e-7 * (1 + 1e-9)
     if key == "damping_check_thermal_damping_sigma_per_c":
         return 0.5e-8 * (1 + 1e-9)
+    if key.startswith("self_cal_"):
+        return 0.5 * (RES_MAP_SIGMA if "sigma" in key else RES_MAP) * (1 + 1e-9)
     raise SystemExit(f"no tolerance for {key}")
 
 
 def compare_keys(csv_keys, can_keys, thermal, bad):
-    wanted = sorted(k for k in csv_keys if k.startswith(("pump_edge_", "damping_check_")))
+    wanted = sorted(k for k in csv_keys if k.startswith(PREFIXES))
     if not any(k.startswith("pump_edge_") for k in wanted):
         bad.append("telemetry.csv has no pump_edge_* keys: the run measured no switch-off")
     if thermal and "damping_check_thermal_damping_per_c" not in wanted:
@@ -72,8 +77,7 @@ def compare_keys(csv_keys, can_keys, thermal, bad):
         print(f"  {k}: {x:.9g} (csv) {y:.9g} (CAN) tol {tol:.3g}")
         if abs(x - y) > tol:
             bad.append(f"{k} differs by {abs(x - y):.3g} > {tol:.3g}")
-    extra = [k for k in can_keys if k.startswith(("pump_edge_", "damping_check_"))
-             and k not in csv_keys]
+    extra = [k for k in can_keys if k.startswith(PREFIXES) and k not in csv_keys]
     if extra:
         bad.append(f"the decoded recording has keys telemetry.csv has not: {extra}")
 

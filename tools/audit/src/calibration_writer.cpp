@@ -7,6 +7,7 @@
 #include <complex>
 #include <cstdio>
 #include <span>
+#include <string_view>
 
 namespace hrg::audit {
 
@@ -106,16 +107,60 @@ void set_thermal_damping(fw::CalibrationFile& out, const Finding& f,
   set(out, "thermal_damping_per_c", c.value[0], c.sigma, 1.0);
 }
 
+// The pickoff map's parts: the effect, its key, the catalogue unit's scale
+// to SI, and the firmware's part (SI) of the self-calibration's map.
+struct PickoffPart {
+  Effect effect;
+  const char* key;
+  double scale;
+  FirmwarePickoffPart FirmwarePickoffMap::*part;
+};
+constexpr PickoffPart kPickoffParts[3] = {
+    {Effect::pickoff_gain_mismatch, "pickoff_y_gain", 1.0, &FirmwarePickoffMap::gain},
+    {Effect::pickoff_misalignment, "pickoff_y_misalignment_rad", kDegToRad,
+     &FirmwarePickoffMap::misalignment_rad},
+    {Effect::pickoff_phase_mismatch, "pickoff_y_phase_rad", kDegToRad,
+     &FirmwarePickoffMap::phase_rad}};
+
+// The catalogue's unit after a value ("" for the gain's "-").
+const char* unit_text(Effect e) {
+  const char* u = effect_info(e).unit;
+  return std::string_view(u) == "-" ? "" : u;
+}
+
+const PickoffPart& pickoff_part(Effect e) {
+  for (const PickoffPart& p : kPickoffParts)
+    if (p.effect == e) return p;
+  throw std::logic_error("not a pickoff effect");
+}
+
+// A pickoff part: the audit's finding and, where the firmware's
+// self-calibration read the whole map (referred to the raw pickoffs, as the
+// audit's finding on a recording without a map in force), its part, the
+// two combined in the catalogue's unit.
+void set_pickoff(fw::CalibrationFile& out, const Finding& f, const CalibrationWriterOptions& opt,
+                 std::vector<std::string>& comments) {
+  const PickoffPart& p = pickoff_part(f.effect);
+  const double audit[1] = {f.value};
+  double firmware = 0.0;
+  double firmware_sigma = 0.0;
+  if (const auto& map = opt.firmware.pickoff) {
+    firmware = ((*map).*p.part).value / p.scale;
+    firmware_sigma = ((*map).*p.part).sigma / p.scale;
+  }
+  const CombinedEstimate c = with_firmware(
+      audit, std::fabs(f.sigma), opt.firmware.pickoff ? &firmware : nullptr, firmware_sigma,
+      std::string(effect_info(f.effect).id) + " (the firmware's: its pickoff self-calibration)",
+      unit_text(f.effect), comments);
+  set(out, p.key, c.value[0], c.sigma, p.scale);
+}
+
 void apply_finding(fw::CalibrationFile& out, const Finding& f, const AuditResult& r,
                    const CalibrationWriterOptions& opt, std::vector<std::string>& comments) {
   switch (f.effect) {
-    case Effect::pickoff_gain_mismatch: set(out, "pickoff_y_gain", f.value, f.sigma, 1.0); break;
+    case Effect::pickoff_gain_mismatch:
     case Effect::pickoff_phase_mismatch:
-      set(out, "pickoff_y_phase_rad", f.value, f.sigma, kDegToRad);
-      break;
-    case Effect::pickoff_misalignment:
-      set(out, "pickoff_y_misalignment_rad", f.value, f.sigma, kDegToRad);
-      break;
+    case Effect::pickoff_misalignment: set_pickoff(out, f, opt, comments); break;
     case Effect::duffing_stiffness: set(out, "duffing_hz_per_v2", f.value, f.sigma, 1.0); break;
     case Effect::nonlinear_damping:
       set(out, "nonlinear_damping_per_v2", f.value, f.sigma, 1.0);
@@ -155,6 +200,18 @@ void firmware_without_finding(const AuditResult& r, const CalibrationWriterOptio
                            k[0], k[1]) +
                        fmt(", y %.4g %+.4gi", k[2], k[3]) +
                        fmt(" +- %.2g V/V; the audit found none", e->sigma_v_per_v));
+  }
+  if (const auto& map = opt.firmware.pickoff) {
+    for (const PickoffPart& p : kPickoffParts) {
+      if (found(r, p.effect)) continue;
+      const FirmwarePickoffPart& part = (*map).*p.part;
+      std::string line = "not applied: the firmware's pickoff self-calibration reads ";
+      line += effect_info(p.effect).id;
+      line += fmt(" %.6g +- %.2g", part.value / p.scale, part.sigma / p.scale);
+      if (*unit_text(p.effect) != '\0') line.append(" ").append(unit_text(p.effect));
+      line += "; the audit found none";
+      comments.push_back(line);
+    }
   }
   if (const auto& e = opt.firmware.thermal_damping; e && !found(r, Effect::thermal_damping)) {
     comments.push_back(

@@ -90,6 +90,33 @@ std::optional<FirmwareThermalDamping> read_thermal_damping(const HeaderKeys& h) 
   return FirmwareThermalDamping{h.number(keys[0]), h.number(keys[1], 1e-300)};
 }
 
+// Each part's value key and its sigma's, and the value's smallest (a gain
+// of -1 or below has no inverse).
+struct PickoffKeys {
+  const char* value;
+  const char* sigma;
+  double min;
+};
+constexpr PickoffKeys kPickoffKeys[3] = {
+    {"self_cal_gain", "self_cal_gain_sigma", -1.0 + 1e-12},
+    {"self_cal_misalignment_rad", "self_cal_misalignment_sigma_rad", -HUGE_VAL},
+    {"self_cal_phase_rad", "self_cal_phase_sigma_rad", -HUGE_VAL}};
+
+std::optional<FirmwarePickoffMap> read_pickoff(const HeaderKeys& h) {
+  std::vector<std::string> keys;
+  for (const PickoffKeys& k : kPickoffKeys) {
+    keys.emplace_back(k.value);
+    keys.emplace_back(k.sigma);
+  }
+  if (!h.any(keys)) return std::nullopt;
+  FirmwarePickoffPart parts[3];
+  for (std::size_t i = 0; i < 3; ++i) {
+    parts[i] = {h.number(kPickoffKeys[i].value, kPickoffKeys[i].min),
+                h.number(kPickoffKeys[i].sigma, 1e-300)};
+  }
+  return FirmwarePickoffMap{parts[0], parts[1], parts[2]};
+}
+
 std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
@@ -107,7 +134,7 @@ std::string values(std::span<const double> v, double sigma, const std::string& u
 
 FirmwareEstimates firmware_estimates(const recording::Recording& rec, const std::string& source) {
   const HeaderKeys h(rec, source);
-  return {read_feedthrough(h), read_thermal_damping(h)};
+  return {read_feedthrough(h), read_thermal_damping(h), read_pickoff(h)};
 }
 
 CombinedEstimate combine_estimates(std::span<const double> audit, double sigma_audit,

@@ -277,10 +277,25 @@ const char* solve_status(est::Status s) {
 }
 
 // The pickoff self-calibration's last solve (est::PickoffSelfCalibration).
+// The whole map the firmware reads (the recording's self_cal_* keys: the map
+// in force composed with the residual below), absent when it does not
+// stand behind one.
+void whole_map_json(JsonWriter& w, const FirmwareEstimates& f) {
+  w.boolean("whole_valid", f.pickoff);
+  if (!f.pickoff) return;
+  w.number("whole_gain", f.pickoff_gain);
+  w.number("whole_gain_sigma", f.pickoff_gain_sigma);
+  w.number("whole_misalignment_rad", f.pickoff_misalignment_rad);
+  w.number("whole_misalignment_sigma_rad", f.pickoff_misalignment_sigma_rad);
+  w.number("whole_phase_rad", f.pickoff_phase_rad);
+  w.number("whole_phase_sigma_rad", f.pickoff_phase_sigma_rad);
+}
+
 void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
                            const fw::app::SelfCalibrationStatus& applied,
-                           const est::PickoffMap& keep) {
+                           const est::PickoffMap& keep, const FirmwareEstimates& f) {
   w.begin_object("self_calibration");
+  whole_map_json(w, f);
   w.integer("rounds_applied", applied.rounds);
   // The map kept for the next power-up (Firmware::pickoff_map_to_keep).
   w.number("keep_gain", keep.gain);
@@ -498,7 +513,8 @@ std::string report_json(const RunConfig& job, const RunResult& r) {
   w.integer("calibration_crc32", fw::calibration_crc(job.firmware.calibration));
   calibration_json(w, r.calibration, r.final_calibration, r.firmware_estimates);
   pump_edge_json(w, r.pump_edge, r.firmware_estimates);
-  self_calibration_json(w, r.self_calibration, r.self_calibration_applied, r.self_calibration_keep);
+  self_calibration_json(w, r.self_calibration, r.self_calibration_applied, r.self_calibration_keep,
+                        r.firmware_estimates);
   w.end_object();
   identification_json(w, r);
   tracking_json(w, r);

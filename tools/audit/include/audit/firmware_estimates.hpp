@@ -9,7 +9,10 @@
 //     pickoffs, on top of the feedthrough in force while its edges were read
 //     (pump_edge_in_force_*);
 //   - damping_check_*: the damping model check's thermal damping coefficient
-//     (est::DampingModelCheck: its factor times the beta in force).
+//     (est::DampingModelCheck: its factor times the beta in force);
+//   - self_cal_*: the pickoff self-calibration's whole y pickoff map
+//     (est::whole_estimate: the map in force composed with the residual its
+//     windows read through it), each part with its own 1 sigma.
 // A recording without a group's keys has no such estimate; a group with a key
 // missing or not a number of its range is refused, naming the key.
 
@@ -37,9 +40,23 @@ struct FirmwareThermalDamping {
   double sigma_per_c = 0.0;
 };
 
+// One part of the pickoff map (gain -, misalignment and phase rad, in the
+// calibration's convention) and its 1 sigma.
+struct FirmwarePickoffPart {
+  double value = 0.0;
+  double sigma = 0.0;
+};
+
+struct FirmwarePickoffMap {
+  FirmwarePickoffPart gain;
+  FirmwarePickoffPart misalignment_rad;
+  FirmwarePickoffPart phase_rad;
+};
+
 struct FirmwareEstimates {
   std::optional<FirmwareFeedthrough> feedthrough;
   std::optional<FirmwareThermalDamping> thermal_damping;
+  std::optional<FirmwarePickoffMap> pickoff;
 };
 
 // Reads the keys of `rec`'s header; throws std::runtime_error naming the

@@ -107,6 +107,9 @@ class Firmware {
   // takes out its damping model or its gap harmonic when their checks
   // refute them.
   void judge_calibration();
+  // A calibration's pickoff map `withdrawn` left the chain: the
+  // self-calibration's windows re-referred to the raw pickoffs.
+  void refer_self_calibration_to_raw(const est::PickoffMap& withdrawn);
   void judge_calibration_parts();
   // Puts the parts of `cal` beyond the chain in force: the resonator model
   // (estimator regressors and drift), the known gap harmonic, and, when the

@@ -26,7 +26,9 @@ namespace hrg::fw::can {
 // 4: why the compensation is not valid (HRG_STATUS.comp_reasons, DLC 7 -> 8)
 //    and the model check against the readout's pattern
 //    (HRG_EST_QUALITY.readout_damping_sigmas).
-inline constexpr uint8_t kProtocolVersion = 4;
+// 5: HRG_CAL_READINGS pages 7-9, the pickoff self-calibration's whole map
+//    (a set of 10 pages; a log of protocol 4 is decoded with its own DBC).
+inline constexpr uint8_t kProtocolVersion = 5;
 inline constexpr uint32_t kBitrateBps = 1'000'000;
 
 // Telemetry messages, in table order (index into kTelemetry).
@@ -51,7 +53,7 @@ inline constexpr std::size_t kTelemetryCount = 15;
 
 // HRG_CAL_READINGS is multiplexed: one page per frame, pages 0 to
 // kCalReadingsPages - 1 in turn, all of one set from the same readings.
-inline constexpr uint8_t kCalReadingsPages = 7;
+inline constexpr uint8_t kCalReadingsPages = 10;
 
 // Host commands, in table order (index into kCommands); id = 0x080 + index.
 enum class Cmd : uint8_t { set_mode, ident, window, agc, status_request };
@@ -143,7 +145,14 @@ enum CalReadings : uint8_t {
   pump_edge_in_force_y_re,
   pump_edge_in_force_y_im,
   thermal_damping_per_c,
-  thermal_damping_sigma_per_c
+  thermal_damping_sigma_per_c,
+  self_cal_valid,
+  self_cal_gain,
+  self_cal_gain_sigma,
+  self_cal_misalignment,
+  self_cal_misalignment_sigma,
+  self_cal_phase,
+  self_cal_phase_sigma
 };
 enum LabTable : uint8_t { table_rate_dps, table_temp_c, table_seq };
 enum SetMode : uint8_t { target_mode, set_mode_counter, set_mode_crc };
