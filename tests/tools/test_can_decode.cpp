@@ -4,6 +4,7 @@
 // the transmitted samples and whose metadata counts exactly the removed frames.
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -321,6 +322,62 @@ TEST(CanDecode, WithoutAFeedthroughThermalOrPickoffReadingTheirKeysAreLeftOut) {
   CHECK_TRUE(rec.metadata_value("self_cal_gain").empty());
   std::remove(path.c_str());
   std::remove(o.out_path.c_str());
+}
+
+namespace {
+
+// The DBC of protocol 4: HRG_CAL_READINGS pages 0-6, no pickoff map.
+std::string protocol_4_dbc() {
+  const std::string path = "test_can_decode_protocol_4.dbc";
+  std::ifstream in(std::string(std::getenv("HRG_SOURCE_DIR")) + "/firmware/can/hrg.dbc");
+  std::ofstream out(path);
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("self_cal_") != std::string::npos) continue;
+    const auto page = line.find("SG_ page M : 0|4@1+ (1,0) [0|9]");
+    if (page != std::string::npos) line.replace(line.find("[0|9]"), 5, "[0|6]");
+    out << line << "\n";
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST(CanDecode, ALogOfProtocol4DecodesWithItsOwnDbcAndHasNoPickoffMap) {
+  // GIVEN a log with one set of 7 pages, as protocol 4 sent it, and rows
+  const std::string path = "test_can_decode_p4.log";
+  {
+    hrg::can::CandumpLogWriter w(path);
+    hrg::hal::CanFrame f;
+    const TelemetrySnapshot s = sample(0);
+    encode_telemetry(Tm::info, s, 0, f);
+    w.write(f, kT0Ns + 1);
+    encode_telemetry(Tm::reference, s, 0, f);
+    w.write(f, kT0Ns + 2);
+    for (uint8_t page = 0; page < 7; ++page) {
+      encode_cal_readings(s.estimates, page, page, f);
+      w.write(f, kT0Ns + 100'000'000ull * (page + 1));
+      const TelemetrySnapshot row = sample(10 * page);
+      for (const Tm m : {Tm::wave_x, Tm::wave_y, Tm::row}) {
+        encode_telemetry(m, row, page, f);
+        w.write(f, kT0Ns + 100'000'000ull * (page + 1) + 10);
+      }
+    }
+  }
+  // WHEN it is decoded with the DBC of its protocol
+  hrg::can::CanDecodeOptions o = options(path, "test_can_decode_p4.csv");
+  o.dbc_path = protocol_4_dbc();
+  const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
+  // THEN the set of 7 is complete, its keys written, no self_cal_* key
+  LONGS_EQUAL(1, s.cal_readings_sets);
+  const hrg::recording::Recording rec = hrg::recording::read_recording(o.out_path);
+  LONGS_EQUAL(1, static_cast<long>(key(rec, "pump_edge_edges")));
+  CHECK_TRUE(rec.metadata_value("self_cal_gain").empty());
+  // AND with this protocol's DBC the 7 pages are no set (nothing guessed)
+  o.dbc_path = std::string(std::getenv("HRG_SOURCE_DIR")) + "/firmware/can/hrg.dbc";
+  LONGS_EQUAL(0, hrg::can::can_decode(o).cal_readings_sets);
+  std::remove(path.c_str());
+  std::remove(o.out_path.c_str());
+  std::remove("test_can_decode_protocol_4.dbc");
 }
 
 TEST(CanDecode, AReadingOutsideItsRangeIsRefusedNamingTheMessageTheSignalAndTheLine) {

@@ -10,10 +10,12 @@ same feedthrough, combined with the switch-off step check's reading, within
 what that resolution moves it.
 
 usage: readings.py HRG SCENARIO CALIBRATION|- DURATION_S WORKDIR [--keys-only] [--thermal]
+       [--pickoff]
 CALIBRATION '-': none in force.
 --keys-only: the keys alone (a calibration that removes the feedthrough
 leaves the audit nothing to find, and the file nothing to combine).
 --thermal: the run must have the damping model check's thermal reading.
+--pickoff: the run must have the pickoff self-calibration's map.
 Exit status 0 when they agree; prints every key and value compared.
 """
 import os
@@ -63,12 +65,14 @@ def tolerance(key):
     raise SystemExit(f"no tolerance for {key}")
 
 
-def compare_keys(csv_keys, can_keys, thermal, bad):
+def compare_keys(csv_keys, can_keys, thermal, pickoff, bad):
     wanted = sorted(k for k in csv_keys if k.startswith(PREFIXES))
     if not any(k.startswith("pump_edge_") for k in wanted):
         bad.append("telemetry.csv has no pump_edge_* keys: the run measured no switch-off")
     if thermal and "damping_check_thermal_damping_per_c" not in wanted:
         bad.append("telemetry.csv has no damping_check_* keys: the run has no thermal reading")
+    if pickoff and "self_cal_gain" not in wanted:
+        bad.append("telemetry.csv has no self_cal_* keys: the run has no pickoff map")
     for k in wanted:
         if k not in can_keys:
             bad.append(f"{k} missing from the decoded recording")
@@ -128,8 +132,9 @@ def compare_files(csv_cal, can_cal, bad):
 
 def main():
     flags = sys.argv[6:]
-    keys_only, thermal = "--keys-only" in flags, "--thermal" in flags
-    if len(sys.argv) < 6 or len(flags) != keys_only + thermal:
+    keys_only, thermal, pickoff = ("--keys-only" in flags, "--thermal" in flags,
+                                   "--pickoff" in flags)
+    if len(sys.argv) < 6 or len(flags) != keys_only + thermal + pickoff:
         raise SystemExit(__doc__)
     hrg, scenario, cal, duration, work = sys.argv[1:6]
     os.makedirs(work, exist_ok=True)
@@ -142,7 +147,7 @@ def main():
     sys.stdout.write(dec)
     csv = os.path.join(work, "sim", "telemetry.csv")
     bad = []
-    compare_keys(header(csv), header(decoded), thermal, bad)
+    compare_keys(header(csv), header(decoded), thermal, pickoff, bad)
     files = (os.path.join(work, "csv.toml"), os.path.join(work, "can.toml"))
     if not keys_only:
         for rec, out in zip((csv, decoded), files):
