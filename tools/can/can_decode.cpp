@@ -289,14 +289,15 @@ void print_summary(const CanDecodeOptions& o, const CanDecodeSummary& s) {
   if (s.estimates) {
     std::printf(
         "can-decode: firmware readings from the last of %llu complete HRG_CAL_READINGS "
-        "sets (%s%s)\n",
+        "sets (%s%s%s)\n",
         static_cast<unsigned long long>(s.cal_readings_sets),
         s.estimates->feedthrough ? "pump_edge_*" : "no edge",
-        s.estimates->thermal_damping ? ", damping_check_*" : "");
+        s.estimates->thermal_damping ? ", damping_check_*" : "",
+        s.estimates->pickoff ? ", self_cal_*" : "");
   } else {
     std::printf(
-        "can-decode: no complete HRG_CAL_READINGS set: no pump_edge_* or damping_check_* "
-        "keys\n");
+        "can-decode: no complete HRG_CAL_READINGS set: no pump_edge_*, damping_check_* or "
+        "self_cal_* keys\n");
   }
   if (s.cal_readings_dropped > 0) {
     std::printf("can-decode: %llu HRG_CAL_READINGS sets with a page lost or out of turn not used\n",
@@ -318,7 +319,7 @@ int can_decode_main(std::span<char* const> args) {
     std::fprintf(stderr,
                  "usage: hrg can-decode LOG -o REC.csv[.gz] [--dbc FILE] [--angular-gain K] "
                  "[--f-ref-hz F]\n"
-                 "Turns a candump -l log of HRG telemetry (protocol 2 to 4; a log of an earlier\n"
+                 "Turns a candump -l log of HRG telemetry (protocol 2 to 5; a log of an earlier\n"
                  "protocol than the DBC's with that protocol's DBC) into an hrg-recording v1 that\n"
                  "hrg audit reads (envelopes against HRG_REFERENCE, rows at HRG_ROW.t_s, the\n"
                  "drive as applied, rate and temperature from the bench's LAB_TABLE, the\n"

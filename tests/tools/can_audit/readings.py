@@ -65,7 +65,7 @@ def tolerance(key):
     raise SystemExit(f"no tolerance for {key}")
 
 
-def compare_keys(csv_keys, can_keys, thermal, pickoff, bad):
+def compare_keys(csv_keys, can_keys, thermal, bad, pickoff=False):
     wanted = sorted(k for k in csv_keys if k.startswith(PREFIXES))
     if not any(k.startswith("pump_edge_") for k in wanted):
         bad.append("telemetry.csv has no pump_edge_* keys: the run measured no switch-off")
@@ -147,7 +147,7 @@ def main():
     sys.stdout.write(dec)
     csv = os.path.join(work, "sim", "telemetry.csv")
     bad = []
-    compare_keys(header(csv), header(decoded), thermal, pickoff, bad)
+    compare_keys(header(csv), header(decoded), thermal, bad, pickoff)
     files = (os.path.join(work, "csv.toml"), os.path.join(work, "can.toml"))
     if not keys_only:
         for rec, out in zip((csv, decoded), files):
