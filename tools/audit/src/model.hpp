@@ -4,9 +4,11 @@
 // The fitted model: the seed's averaged equations (physics.md section 2) in
 // the carrier frame, Z' = A Z with
 //   A = i(dw0 I + dw [c4w s4w; s4w -c4w]) - s (nu I + [dnuC dnuS; dnuS -dnuC])
-//       + Omega K [0 1; -1 0],
+//       + (Omega K + (2 pi / 3) c Q) [0 1; -1 0],
 // measured through the pickoff matrix C (gain, phase, misalignment), plus the
-// catalogue's extensions as extra parameters that start at zero. Each
+// catalogue's extensions as extra parameters that start at zero (a Duffing
+// term c both shifts dw0 by 2 pi c a_A^2 and turns the pattern through the
+// quadrature Q = 2 a_A a_B of each block, read through C's inverse). Each
 // free-decay segment has its own initial state, solved by linear least
 // squares inside every evaluation (variable projection).
 
