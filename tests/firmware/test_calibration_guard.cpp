@@ -139,3 +139,22 @@ TEST(CalibrationGuard, AStepWithdrawsAFeedthroughCalibrationAtOnceButNotAPickoff
   CHECK_FALSE(pickoff.judge(checked(2, 1.0), true, 120.0, PumpEdgeVerdict::step));
   CHECK(pickoff.status().verdict == CalibrationVerdict::confirmed);
 }
+
+TEST(CalibrationGuard, AWithdrawalByTheFirmwareIsReportedAndNotJudgedAgain) {
+  // GIVEN an online round on trial, then the map before it put back (the
+  // identity)
+  CalibrationGuard g(kMinMisfit, kMaxMisfit);
+  g.applied(CalibrationSource::online, 11, false, 100.0, checked(5, 1.0), true);
+  g.applied(CalibrationSource::online, 0, true, 190.0, checked(6, 1.0), true);
+  // WHEN the firmware reports the round withdrawn
+  g.withdrawn(CalibrationSource::online, 11, 190.0);
+  // THEN it is the verdict (HRG_STATUS cal_withdrawn, report.json) with the
+  // round's CRC, counted, and no later window judges anything
+  CHECK(g.status().verdict == CalibrationVerdict::withdrawn);
+  CHECK(g.status().source == CalibrationSource::online);
+  CHECK_EQUAL(11u, g.status().crc32);
+  DOUBLES_EQUAL(190.0, g.status().judged_s, 0.0);
+  CHECK_EQUAL(1u, g.status().withdrawals);
+  CHECK_FALSE(g.judge(checked(7, 90.0), true, 200.0));
+  CHECK(g.status().verdict == CalibrationVerdict::withdrawn);
+}

@@ -49,6 +49,12 @@ bool CalibrationGuard::withdraw(double t_s) {
   return true;
 }
 
+void CalibrationGuard::withdrawn(CalibrationSource source, uint32_t crc32, double t_s) {
+  status_.source = source;
+  status_.crc32 = crc32;
+  withdraw(t_s);
+}
+
 bool CalibrationGuard::judge(const EstimatorHealth& h, bool checking, double t_s,
                              PumpEdgeVerdict edge) {
   const bool in_force = status_.verdict == CalibrationVerdict::on_trial ||

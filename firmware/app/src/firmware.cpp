@@ -45,26 +45,15 @@ bool has_feedthrough(const Calibration& cal) {
          cal.feedthrough_y_re_v_per_v != 0.0 || cal.feedthrough_y_im_v_per_v != 0.0;
 }
 
-bool significant(const est::PickoffSelfCalResult& r, double n_sigma) {
-  return std::fabs(r.gain) > n_sigma * r.gain_sigma ||
-         std::fabs(r.misalignment_rad) > n_sigma * r.misalignment_sigma_rad ||
-         std::fabs(r.phase_rad) > n_sigma * r.phase_sigma_rad;
-}
-
-// The estimate's information has grown by `factor` since `before` (every
-// parameter's variance divided by it at least).
-bool better_by(const est::PickoffSelfCalResult& r, const est::PickoffSelfCalResult& before,
-               double factor) {
-  const auto shrunk = [factor](double now, double then) {
-    return now * now * factor <= then * then;
-  };
-  return shrunk(r.gain_sigma, before.gain_sigma) &&
-         shrunk(r.misalignment_sigma_rad, before.misalignment_sigma_rad) &&
-         shrunk(r.phase_sigma_rad, before.phase_sigma_rad);
-}
-
 est::PickoffMap pickoff_map(const Calibration& cal) {
   return {cal.pickoff_y_gain, cal.pickoff_y_misalignment_rad, cal.pickoff_y_phase_rad};
+}
+
+Calibration with_pickoff_map(Calibration cal, const est::PickoffMap& m) {
+  cal.pickoff_y_gain = m.gain;
+  cal.pickoff_y_misalignment_rad = m.misalignment_rad;
+  cal.pickoff_y_phase_rad = m.phase_rad;
+  return cal;
 }
 
 }  // namespace
@@ -144,46 +133,33 @@ void Firmware::self_calibrate() {
   // Once per fresh solve, never inside a window (the identifier restarts).
   if (r.samples == self_cal_samples_seen_ || gyro_.status().mode != Mode::operate) return;
   self_cal_samples_seen_ = r.samples;
-  // Nothing while one decay rate does not hold across the windows: a damping
-  // that changes between them reads as a level pattern.
-  if (r.status != est::Status::ok || !r.decay_consistent || self_cal_.rounds >= kMaxSelfCalRounds) {
-    return;
-  }
-  // First an estimate that stands out of its noise; then the residual of
-  // every window so far (re-referred through what is in force) whenever it
-  // stands out, or the information behind it has doubled.
-  const bool apply = significant(r, kSelfCalSignificance) ||
-                     (self_cal_.rounds > 0 && better_by(r, self_cal_.applied, 2.0));
-  if (!apply) return;
-  // Each part of the whole estimate (what is in force composed with the
-  // residual) weighted by its evidence: a part within its noise of zero
-  // would only add its noise to the output, and a part an earlier round
-  // applied is judged again with every window since.
   const est::PickoffMap in_force = pickoff_map(cfg_.calibration);
-  const est::PickoffMap target = est::evidence_weighted_map(in_force, r);
-  if (target == in_force) return;
-  Calibration next = cfg_.calibration;
-  next.pickoff_y_gain = target.gain;
-  next.pickoff_y_misalignment_rad = target.misalignment_rad;
-  next.pickoff_y_phase_rad = target.phase_rad;
-  if (!apply_calibration(next, CalibrationSource::online)) return;
-  const est::PickoffSelfCalResult step = est::step_between(in_force, target, r);
-  ++self_cal_.rounds;
-  self_cal_.applied = step;
-  self_cal_.applied_s = gyro_.status().chain.t_s;
+  const SelfCalibrationDecision d = self_cal_.decide(r, in_force);
+  if (d.action == SelfCalibrationAction::none || !put_self_calibration_in_force(d)) return;
+  self_cal_.done(d, r, in_force, gyro_.status().chain.t_s);
   // The model's windows were taken through the old correction: it starts
   // again; the self-calibration keeps its windows, re-referred.
-  estimator_.restart_after_correction(step);
+  estimator_.restart_after_correction(d.step);
   gyro_.restart_identification();
+}
+
+bool Firmware::put_self_calibration_in_force(const SelfCalibrationDecision& d) {
+  const uint32_t crc_withdrawn = guard_.status().crc32;
+  if (!apply_calibration(with_pickoff_map(cfg_.calibration, d.target), CalibrationSource::online))
+    return false;
+  // The map before the rounds is back where they held nothing, as it was
+  // before them (not on trial again); what the firmware reports is the
+  // withdrawal, where a check window's would go (HRG_STATUS cal_withdrawn,
+  // report.json).
+  if (d.action == SelfCalibrationAction::withdraw)
+    guard_.withdrawn(CalibrationSource::online, crc_withdrawn, gyro_.status().chain.t_s);
+  return true;
 }
 
 est::PickoffMap Firmware::pickoff_map_to_keep() const {
   const est::PickoffMap in_force = pickoff_map(cfg_.calibration);
-  const est::PickoffSelfCalResult& r = estimator_.pickoff_self_calibration();
-  if (!cfg_.online_pickoff_calibration || r.status != est::Status::ok || !r.decay_consistent)
-    return in_force;
-  if (self_cal_.rounds == 0 && !significant(r, kSelfCalSignificance)) return in_force;
-  return est::evidence_weighted_map(in_force, r);
+  if (!cfg_.online_pickoff_calibration) return in_force;
+  return self_cal_.map_to_keep(estimator_.pickoff_self_calibration(), in_force);
 }
 
 void Firmware::refer_self_calibration_to_raw(const est::PickoffMap& withdrawn) {

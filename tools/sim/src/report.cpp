@@ -131,7 +131,17 @@ bool judge(const RunConfig& job, RunResult& r) {
     const fw::app::CalibrationStatus& c = r.calibration;
     const std::string before =
         c.misfit_before > 0.0 ? fmt(" and the check before it (%.2f)", c.misfit_before) : "";
-    if (c.edge == fw::PumpEdgeVerdict::step) {
+    const fw::app::SelfCalibrationStatus& sc = r.self_calibration_applied;
+    if (c.source == fw::app::CalibrationSource::online && sc.withdrawn) {
+      r.failures.push_back(
+          fmt("the online pickoff self-calibration's %u round(s) were withdrawn at %.1f s: "
+              "its per-window decay test refutes the one decay rate they were solved with "
+              "(F %.3g against %.3g), and its fit with a decay rate per window holds what "
+              "they changed at %.2f sigma; those parts of the map before them are in force "
+              "and kept",
+              sc.rounds, sc.withdrawn_s, sc.withdrawn_decay_f, sc.withdrawn_decay_f_limit,
+              sc.withdrawn_support_sigmas));
+    } else if (c.edge == fw::PumpEdgeVerdict::step) {
       r.failures.push_back(
           fmt("the %s calibration was withdrawn at %.1f s: the signal it "
               "corrected steps at the pump's switch-offs (its feedthrough "
@@ -297,6 +307,14 @@ void self_calibration_json(JsonWriter& w, const est::PickoffSelfCalResult& s,
   w.begin_object("self_calibration");
   whole_map_json(w, f);
   w.integer("rounds_applied", applied.rounds);
+  // The rounds taken back when their model was refuted (Firmware::
+  // self_calibrate, fw::app::SelfCalibrationRounds): every round then.
+  w.integer("rounds_withdrawn", applied.withdrawn ? applied.rounds : 0);
+  w.boolean("withdrawn", applied.withdrawn);
+  w.number("withdrawn_s", applied.withdrawn_s);
+  w.number("withdrawn_decay_f", applied.withdrawn_decay_f);
+  w.number("withdrawn_decay_f_limit", applied.withdrawn_decay_f_limit);
+  w.number("withdrawn_support_sigmas", applied.withdrawn_support_sigmas);
   // The map kept for the next power-up (Firmware::pickoff_map_to_keep).
   w.number("keep_gain", keep.gain);
   w.number("keep_misalignment_deg", keep.misalignment_rad / kDegRad);

@@ -95,6 +95,11 @@ class CalibrationGuard {
   bool judge_damping_model(double factor, double factor_sigma, bool refuted, double t_s);
   // The estimator has refuted the calibration's gap harmonic: true once.
   bool judge_gap(bool refuted, double t_s);
+  // The firmware has taken a calibration out for a reason of its own (the
+  // online self-calibration's rounds, their model refuted) and put back (the
+  // parts of) the map in force before it, which is not judged again:
+  // reported as the `source` calibration `crc32` withdrawn at t_s.
+  void withdrawn(CalibrationSource source, uint32_t crc32, double t_s);
 
   const CalibrationStatus& status() const { return status_; }
 

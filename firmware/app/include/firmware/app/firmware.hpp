@@ -3,22 +3,13 @@
 
 #include "firmware/app/calibration_guard.hpp"
 #include "firmware/app/firmware_config.hpp"
+#include "firmware/app/self_calibration_rounds.hpp"
 #include "firmware/dsp_chain_port.hpp"
 #include "firmware/estimator_port.hpp"
 #include "firmware/gyro.hpp"
-#include "estimator/pickoff_evidence.hpp"
 #include "hal/board.hpp"
 
 namespace hrg::fw::app {
-
-// What the online pickoff self-calibration has put in force.
-struct SelfCalibrationStatus {
-  uint32_t rounds = 0;  // estimates applied (each restarts the model)
-  // The last step applied (est::step_between: what it changed in the map,
-  // with the sigmas of the solve it was weighed on).
-  est::PickoffSelfCalResult applied{};
-  double applied_s = 0.0;  // when
-};
 
 // The firmware assembled on a board: the signal chain over dsp::Chain, the
 // estimator and the gyro (executive, modes, windows, output, CAN) that runs
@@ -65,14 +56,9 @@ class Firmware {
   const Calibration& calibration() const { return cfg_.calibration; }
   const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  // A round is applied when the solve is accepted (conditioning, one decay
-  // rate across the windows) and the estimate stands out of its own noise by
-  // this many sigma; later, when the residual over every window stands out
-  // or its information has doubled since the last round; at most
-  // kMaxSelfCalRounds times. A round puts each part of the whole estimate in
-  // force weighted by its evidence (est::evidence_weighted_map).
-  static constexpr double kSelfCalSignificance = 5.0;
-  static constexpr uint32_t kMaxSelfCalRounds = 4;
+  // The online pickoff self-calibration's rules (SelfCalibrationRounds).
+  static constexpr double kSelfCalSignificance = SelfCalibrationRounds::kSignificance;
+  static constexpr uint32_t kMaxSelfCalRounds = SelfCalibrationRounds::kMaxRounds;
 
   void run_frame() {
     // Once per set of HRG_CAL_READINGS (0.7 s at the default rate), not per
@@ -82,13 +68,11 @@ class Firmware {
     judge_calibration();
     if (cfg_.online_pickoff_calibration) self_calibrate();
   }
-  const SelfCalibrationStatus& self_calibration() const { return self_cal_; }
-  // The pickoff map a board keeps for the next power-up: what a round would
-  // put in force now (the whole estimate of every window, each part weighted
-  // by its evidence, est::evidence_weighted_map) once a round has been
-  // applied or the estimate stands out; else the map in force (also while
-  // the online self-calibration is off, its solve fails or the decay test
-  // refuses its windows).
+  const SelfCalibrationStatus& self_calibration() const { return self_cal_.status(); }
+  // The pickoff map a board keeps for the next power-up
+  // (SelfCalibrationRounds::map_to_keep; the map in force while the online
+  // self-calibration is off, and after a withdrawal of its rounds the map
+  // the withdrawal left: the one before them where they held nothing).
   est::PickoffMap pickoff_map_to_keep() const;
   // The firmware's own readings of what a calibration holds, now: the
   // switch-off step check's residual referred to the raw pickoffs through
@@ -116,8 +100,11 @@ class Firmware {
   // electronics correction changed, a fresh switch-off step check.
   void put_in_force(const Calibration& cal, bool electronics_changed);
   // Folds a fresh, significant self-calibration estimate into the
-  // correction and starts the identification again.
+  // correction, or withdraws the rounds when their model is refuted
+  // (SelfCalibrationRounds), and starts the identification again.
   void self_calibrate();
+  // Puts the self-calibration's `d` in force: true when the chain took it.
+  bool put_self_calibration_in_force(const SelfCalibrationDecision& d);
   // The estimator's check windows count (the campaign is over, or none runs).
   bool checking() const;
 
@@ -126,7 +113,7 @@ class Firmware {
   EstimatorPort estimator_;
   Gyro gyro_;
   CalibrationGuard guard_;
-  SelfCalibrationStatus self_cal_{};
+  SelfCalibrationRounds self_cal_{};
   int self_cal_samples_seen_ = 0;
   bool calibration_ok_ = true;
 
