@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `hrg audit --calibration` with the firmware's own estimates in the
-// recording's header (pump_edge_*, damping_check_*, self_cal_*): read, refused when
-// malformed, combined with the audit's by one rule.
+// recording's header (pump_edge_*, damping_check_*, self_cal_*): read,
+// refused when malformed, combined with the audit's by one rule.
 #include "audit/firmware_estimates.hpp"
 
 #include <array>

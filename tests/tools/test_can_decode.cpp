@@ -289,29 +289,36 @@ TEST(CanDecode, ASetWithALostPageIsNotUsedAndWithoutACompleteSetNoKeyIsWritten) 
   std::remove(o.out_path.c_str());
 }
 
+namespace {
+
+// A log of one set of HRG_CAL_READINGS from `e`, pages 0 to `pages` - 1,
+// beside rows (a recording has some), HRG_INFO and HRG_REFERENCE.
+void write_one_set(const std::string& path, const FirmwareEstimates& e, uint8_t pages) {
+  hrg::can::CandumpLogWriter w(path);
+  const TelemetrySnapshot s = sample(0);
+  w.write(encode_lab_table(0, 25, 0), kT0Ns);
+  hrg::hal::CanFrame f;
+  encode_telemetry(Tm::info, s, 0, f);
+  w.write(f, kT0Ns + 1);
+  encode_telemetry(Tm::reference, s, 0, f);
+  w.write(f, kT0Ns + 2);
+  for (uint8_t page = 0; page < pages; ++page) {
+    encode_cal_readings(e, page, page, f);
+    w.write(f, kT0Ns + 100'000'000ull * (page + 1));
+    const TelemetrySnapshot row = sample(10 * page);
+    for (const Tm m : {Tm::wave_x, Tm::wave_y, Tm::row}) {
+      encode_telemetry(m, row, page, f);
+      w.write(f, kT0Ns + 100'000'000ull * (page + 1) + 10);
+    }
+  }
+}
+
+}  // namespace
+
 TEST(CanDecode, WithoutAFeedthroughThermalOrPickoffReadingTheirKeysAreLeftOut) {
   // GIVEN a set sent with no edge, no thermal reading and no pickoff map
   const std::string path = "test_can_decode_none.log";
-  {
-    hrg::can::CandumpLogWriter w(path);
-    TelemetrySnapshot s = sample(0);
-    w.write(encode_lab_table(0, 25, 0), kT0Ns);
-    hrg::hal::CanFrame f;
-    encode_telemetry(Tm::info, s, 0, f);
-    w.write(f, kT0Ns + 1);
-    encode_telemetry(Tm::reference, s, 0, f);
-    w.write(f, kT0Ns + 2);
-    for (uint8_t page = 0; page < kCalReadingsPages; ++page) {
-      encode_cal_readings(FirmwareEstimates{}, page, page, f);
-      w.write(f, kT0Ns + 100'000'000ull * (page + 1));
-      // ... beside rows (a recording has some)
-      const TelemetrySnapshot row = sample(10 * page);
-      for (const Tm m : {Tm::wave_x, Tm::wave_y, Tm::row}) {
-        encode_telemetry(m, row, page, f);
-        w.write(f, kT0Ns + 100'000'000ull * (page + 1) + 10);
-      }
-    }
-  }
+  write_one_set(path, FirmwareEstimates{}, kCalReadingsPages);
   hrg::can::CanDecodeOptions o = options(path, "test_can_decode_none.csv");
   const hrg::can::CanDecodeSummary s = hrg::can::can_decode(o);
   // THEN the set is read, and says there is nothing to write
@@ -345,24 +352,7 @@ std::string protocol_4_dbc() {
 TEST(CanDecode, ALogOfProtocol4DecodesWithItsOwnDbcAndHasNoPickoffMap) {
   // GIVEN a log with one set of 7 pages, as protocol 4 sent it, and rows
   const std::string path = "test_can_decode_p4.log";
-  {
-    hrg::can::CandumpLogWriter w(path);
-    hrg::hal::CanFrame f;
-    const TelemetrySnapshot s = sample(0);
-    encode_telemetry(Tm::info, s, 0, f);
-    w.write(f, kT0Ns + 1);
-    encode_telemetry(Tm::reference, s, 0, f);
-    w.write(f, kT0Ns + 2);
-    for (uint8_t page = 0; page < 7; ++page) {
-      encode_cal_readings(s.estimates, page, page, f);
-      w.write(f, kT0Ns + 100'000'000ull * (page + 1));
-      const TelemetrySnapshot row = sample(10 * page);
-      for (const Tm m : {Tm::wave_x, Tm::wave_y, Tm::row}) {
-        encode_telemetry(m, row, page, f);
-        w.write(f, kT0Ns + 100'000'000ull * (page + 1) + 10);
-      }
-    }
-  }
+  write_one_set(path, sample(0).estimates, 7);
   // WHEN it is decoded with the DBC of its protocol
   hrg::can::CanDecodeOptions o = options(path, "test_can_decode_p4.csv");
   o.dbc_path = protocol_4_dbc();
