@@ -36,12 +36,7 @@ PickoffSelfCalResult step_between(const PickoffMap& from, const PickoffMap& to,
   s.gain = (1.0 + to.gain) / (1.0 + from.gain) - 1.0;
   s.misalignment_rad = to.misalignment_rad - from.misalignment_rad;
   s.phase_rad = to.phase_rad - from.phase_rad;
-  // The step's own level pattern, as the fit's columns read it.
-  const double k = (1.0 + s.gain) * (1.0 + s.gain);
-  const double rho = (k - 1.0) / (k + 1.0);
-  const double bh = std::sin(2.0 * s.misalignment_rad) / (2.0 * std::sqrt(1.0 - rho * rho));
-  s.level_8th_c = 0.5 * rho * rho - 2.0 * bh * bh;
-  s.level_8th_s = -2.0 * rho * bh;
+  set_step_terms(s);
   return s;
 }
 

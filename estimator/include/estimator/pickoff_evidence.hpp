@@ -68,9 +68,10 @@ PickoffMap evidence_weighted_map(const PickoffMap& in_force, const PickoffSelfCa
 
 // The step from `from` to `to` as a residual result that
 // PickoffSelfCalibration::refer_to_applied takes: r with its pickoff parts
-// replaced by the step's (gain ratio, angle differences) and its 8theta
-// level terms by the step's own (the O(g^2) part of ln(1 + rho r - 2 bh s):
-// h_c = rho^2 / 2 - 2 bh^2, h_s = -2 rho bh). The sigmas stay r's.
+// replaced by the step's (gain ratio, angle differences) and its 8theta and
+// 12theta level terms by the step's own (level_harmonics_of: the harmonics
+// of -ln(1 + rho r - 2 bh s), h_c = rho^2 / 2 - 2 bh^2, h_s = -2 rho bh to
+// O(g^3), k_c - i k_s = -(rho + 2i bh)^3 / 12 to O(g^5)). The sigmas stay r's.
 PickoffSelfCalResult step_between(const PickoffMap& from, const PickoffMap& to,
                                   const PickoffSelfCalResult& r);
 
