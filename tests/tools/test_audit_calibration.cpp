@@ -20,12 +20,14 @@
 #include "firmware/calibration_file.hpp"
 #include "recording/recording.hpp"
 
+#include "support/audit_finding.hpp"
 #include "support/cpputest.hpp"
 
 namespace fs = std::filesystem;
 using hrg::audit::AuditResult;
 using hrg::audit::Effect;
 using hrg::audit::Finding;
+using hrg::test::audit_finding;
 
 namespace {
 
@@ -39,14 +41,6 @@ std::string read_text(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-Finding finding(Effect e, double value, double sigma) {
-  Finding f;
-  f.effect = e;
-  f.value = value;
-  f.sigma = sigma;
-  return f;
 }
 
 }  // namespace
@@ -86,11 +80,11 @@ TEST(AuditCalibration, EveryFindingGoesToItsFieldInSiUnitsAndFeedthroughToThePum
   AuditResult r;
   r.verdict = "explained";
   r.temp_ref_c = 31.5;
-  r.findings.push_back(finding(Effect::pickoff_phase_mismatch, 1.0, 0.004));  // deg
-  r.findings.push_back(finding(Effect::pickoff_misalignment, 0.5, 0.002));    // deg
-  r.findings.push_back(finding(Effect::thermal_frequency, 5.0, 0.01));        // ppm/degC
-  r.findings.push_back(finding(Effect::duffing_stiffness, 1.98e-3, 2e-5));    // Hz/V^2
-  Finding ft = finding(Effect::drive_feedthrough, 1e-3, 1e-5);
+  r.findings.push_back(audit_finding(Effect::pickoff_phase_mismatch, 1.0, 0.004));  // deg
+  r.findings.push_back(audit_finding(Effect::pickoff_misalignment, 0.5, 0.002));    // deg
+  r.findings.push_back(audit_finding(Effect::thermal_frequency, 5.0, 0.01));        // ppm/degC
+  r.findings.push_back(audit_finding(Effect::duffing_stiffness, 1.98e-3, 2e-5));    // Hz/V^2
+  Finding ft = audit_finding(Effect::drive_feedthrough, 1e-3, 1e-5);
   // Against the wave: c_x = 1e-3 e^{i 75 deg}; the pump runs 45 deg ahead of
   // the wave, so per volt of pump envelope k_x = 1e-3 e^{i 30 deg}.
   const std::complex<double> cx = std::polar(1e-3, 75.0 * std::numbers::pi / 180.0);
@@ -123,7 +117,7 @@ TEST(AuditCalibration, EveryFindingGoesToItsFieldInSiUnitsAndFeedthroughToThePum
 TEST(AuditCalibration, AGapHarmonicFindingGoesToBothItsFieldsWithTheirSigmas) {
   AuditResult r;
   r.verdict = "explained";
-  Finding g = finding(Effect::gap_harmonics, std::hypot(0.0193, -0.0098), 0.0014);
+  Finding g = audit_finding(Effect::gap_harmonics, std::hypot(0.0193, -0.0098), 0.0014);
   g.gap_eps_pq_sigma = {0.0193, -0.0098, 0.0014, 0.0008};
   r.findings.push_back(g);
   const auto c = hrg::audit::calibration_from_audit(r, "rec.csv");
@@ -140,7 +134,7 @@ TEST(AuditCalibration, AGapHarmonicFindingGoesToBothItsFieldsWithTheirSigmas) {
 TEST(AuditCalibration, AFindingOutsideTheFirmwaresRangeWritesNothing) {
   AuditResult r;
   r.verdict = "explained";
-  r.findings.push_back(finding(Effect::pickoff_gain_mismatch, 0.3, 1e-4));  // range +-0.2
+  r.findings.push_back(audit_finding(Effect::pickoff_gain_mismatch, 0.3, 1e-4));  // range +-0.2
   const std::string out = "test_audit_calibration_refused.toml";
   std::remove(out.c_str());
   try {

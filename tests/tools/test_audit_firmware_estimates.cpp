@@ -13,12 +13,14 @@
 #include "audit/calibration_writer.hpp"
 #include "recording/recording.hpp"
 
+#include "support/audit_finding.hpp"
 #include "support/cpputest.hpp"
 
 using hrg::audit::AuditResult;
 using hrg::audit::CombinedBy;
 using hrg::audit::Effect;
 using hrg::audit::Finding;
+using hrg::test::audit_finding;
 
 namespace {
 
@@ -227,14 +229,6 @@ hrg::recording::Recording with_self_cal_keys() {
   return rec;
 }
 
-Finding pickoff_finding(Effect e, double value, double sigma) {
-  Finding f;
-  f.effect = e;
-  f.value = value;
-  f.sigma = sigma;
-  return f;
-}
-
 }  // namespace
 
 TEST(FirmwareEstimates, ThePickoffMapsKeysAreReadWithEachPartsSigma) {
@@ -277,7 +271,7 @@ TEST(FirmwareEstimates, AnAcceptedPickoffPartIsWeighedWithTheFirmwaresAndTheOthe
   // pickoff finding) and the firmware's map (-1.00026 +- 0.00035 deg)
   AuditResult r;
   r.verdict = "explained";
-  r.findings.push_back(pickoff_finding(Effect::pickoff_misalignment, -0.99907, 0.00051));
+  r.findings.push_back(audit_finding(Effect::pickoff_misalignment, -0.99907, 0.00051));
   hrg::audit::CalibrationWriterOptions opt;
   const auto plain = hrg::audit::calibration_from_audit(r, "rec.csv", opt);
   opt.firmware = hrg::audit::firmware_estimates(with_self_cal_keys(), "rec.csv");
@@ -311,8 +305,8 @@ TEST(FirmwareEstimates, EachPickoffPartIsCombinedWithItsOwnSigma) {
   // the firmware's 0.01003 +- 2e-5 and 0.9990 +- 0.001 deg
   AuditResult r;
   r.verdict = "explained";
-  r.findings.push_back(pickoff_finding(Effect::pickoff_gain_mismatch, 0.0101, 7e-5));
-  r.findings.push_back(pickoff_finding(Effect::pickoff_phase_mismatch, 1.0, 0.004));
+  r.findings.push_back(audit_finding(Effect::pickoff_gain_mismatch, 0.0101, 7e-5));
+  r.findings.push_back(audit_finding(Effect::pickoff_phase_mismatch, 1.0, 0.004));
   auto rec = with_self_cal_keys();
   rec.set_metadata("self_cal_gain", "0.01003");
   rec.set_metadata("self_cal_gain_sigma", "2e-5");
