@@ -53,8 +53,8 @@ struct GyroConfig {
   // alongside (EstimatorHealth::readout_damping_sigmas): the model then took
   // a pickoff gain or misalignment's 4 theta pattern in E, read while the
   // table turned, for damping. The significance the firmware asks of the
-  // same identification before it applies it (fw::app::Firmware::
-  // kSelfCalSignificance). 0: not checked.
+  // same identification before it applies it (fw::app::
+  // SelfCalibrationRounds::kSignificance). 0: not checked.
   double max_readout_damping_sigmas = 5.0;
   // D_Phi is not applied while the readout's own 4 theta pattern explains
   // what its fits read: the check above trips, or the pickoff

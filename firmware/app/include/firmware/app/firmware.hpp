@@ -56,10 +56,6 @@ class Firmware {
   const Calibration& calibration() const { return cfg_.calibration; }
   const CalibrationStatus& calibration_status() const { return guard_.status(); }
 
-  // The online pickoff self-calibration's rules (SelfCalibrationRounds).
-  static constexpr double kSelfCalSignificance = SelfCalibrationRounds::kSignificance;
-  static constexpr uint32_t kMaxSelfCalRounds = SelfCalibrationRounds::kMaxRounds;
-
   void run_frame() {
     // Once per set of HRG_CAL_READINGS (0.7 s at the default rate), not per
     // frame: the referral to the raw pickoffs costs four sines.
